@@ -1,0 +1,47 @@
+#include "cli_common.hpp"
+
+#include <cstdlib>
+#include <filesystem>
+
+#include <fmt/core.h>
+
+namespace lash::cli {
+
+int guarded(const std::function<int()>& fn) {
+  try {
+    return fn();
+  } catch (const InputError& e) {
+    fmt::print(stderr, "lash: error: {}\n", e.what());
+    return kExitBadInput;
+  } catch (const std::invalid_argument& e) {
+    fmt::print(stderr, "lash: error: {}\n", e.what());
+    return kExitBadInput;
+  }
+}
+
+void write_columns_csv(const std::string& path, const std::vector<std::string>& names,
+                       const std::vector<const std::vector<double>*>& cols) {
+  AtomicFile f(path);
+  std::string line;
+  for (std::size_t i = 0; i < names.size(); ++i) line += (i ? "," : "") + names[i];
+  line += '\n';
+  f.stream() << line;
+  const std::size_t n = cols.empty() ? 0 : cols[0]->size();
+  for (std::size_t k = 0; k < n; ++k) {
+    line.clear();
+    for (std::size_t c = 0; c < cols.size(); ++c) {
+      if (c) line += ',';
+      append_double(line, (*cols[c])[k]);
+    }
+    line += '\n';
+    f.stream() << line;
+  }
+  f.commit();
+}
+
+std::string source_dir() {
+  if (const char* s = std::getenv("LASH_SOURCE_DIR")) return s;
+  return LASH_SOURCE_DIR;
+}
+
+}  // namespace lash::cli

@@ -1,0 +1,41 @@
+#pragma once
+// Shared pieces of the lash command line: the subcommand registry, the
+// error → exit-status mapping and small output helpers.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "lash/io/atomic_file.hpp"
+#include "lash/io/csv.hpp"
+#include "lash/io/error.hpp"
+
+namespace lash::cli {
+
+/// Exit statuses: 0 ok, 1 the job ran but failed its own check, 2 bad input.
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitFailed = 1;
+inline constexpr int kExitBadInput = 2;
+
+/// A subcommand adds itself to the app and sets `run` to the function that executes it.
+struct Command {
+  CLI::App* app = nullptr;
+  std::function<int()> run;
+};
+
+/// Each subcommand file defines one of these.
+Command add_simulate(CLI::App& app);
+Command add_demo(CLI::App& app);
+
+/// Runs `fn`, mapping InputError and std::invalid_argument to exit 2 with a message on stderr.
+int guarded(const std::function<int()>& fn);
+
+/// Writes named columns as CSV (round-trip precision) atomically to `path`.
+void write_columns_csv(const std::string& path, const std::vector<std::string>& names,
+                       const std::vector<const std::vector<double>*>& cols);
+
+/// Root of the source tree (for shipped config files); LASH_SOURCE_DIR or the compiled-in path.
+std::string source_dir();
+
+}  // namespace lash::cli

@@ -1,0 +1,24 @@
+// lash — online deadzone/backlash identification, simulation and CAN HIL emulation.
+#include <CLI/CLI.hpp>
+
+#include "cli_common.hpp"
+
+int main(int argc, char** argv) {
+  using namespace lash::cli;
+  CLI::App app{"lash: identify deadzones and backlash online, simulate such plants, emulate ECUs over CAN"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "lash 0.1.0");
+  std::vector<Command> commands{
+      add_simulate(app),
+      add_demo(app),
+  };
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : kExitBadInput;
+  }
+  for (auto& c : commands)
+    if (c.app->parsed()) return guarded(c.run);
+  return kExitBadInput;
+}

@@ -1,0 +1,66 @@
+#include "plot.hpp"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <fmt/core.h>
+
+#include "lash/io/error.hpp"
+
+namespace lash::cli {
+
+void run_gnuplot(const std::string& script_in, const std::string& png_path) {
+  const std::string tmp_png = png_path + ".tmp." + std::to_string(::getpid()) + ".png";
+  std::string script = script_in;
+  for (auto pos = script.find("<OUTPUT>"); pos != std::string::npos; pos = script.find("<OUTPUT>"))
+    script.replace(pos, 8, tmp_png);
+  const std::string gp = png_path + ".tmp." + std::to_string(::getpid()) + ".gp";
+  {
+    std::ofstream f(gp);
+    f << script;
+  }
+  const std::string cmd = "gnuplot '" + gp + "' 2>&1";
+  FILE* p = ::popen(cmd.c_str(), "r");
+  std::string out;
+  int status = -1;
+  if (p) {
+    char buf[512];
+    while (std::fgets(buf, sizeof buf, p)) out += buf;
+    status = ::pclose(p);
+  }
+  std::error_code ec;
+  std::filesystem::remove(gp, ec);
+  if (status != 0 || !std::filesystem::exists(tmp_png)) {
+    std::filesystem::remove(tmp_png, ec);
+    throw InputError(png_path, 0, "--plot", "gnuplot failed (is gnuplot-nox installed?): " + out);
+  }
+  std::filesystem::rename(tmp_png, png_path, ec);
+  if (ec) throw InputError(png_path, 0, "--plot", "cannot write: " + ec.message());
+}
+
+void plot_csv(const std::string& csv_path, const std::string& png_path, const std::string& title,
+              const std::vector<PlotPanel>& panels, const std::vector<PlotSeries>& series) {
+  const int n = static_cast<int>(panels.size());
+  std::string s;
+  s += fmt::format("set terminal pngcairo noenhanced size 1200,{} font 'sans,10'\n", 300 * n + 60);
+  s += "set output '<OUTPUT>'\nset datafile separator ','\nset key autotitle columnhead\nset grid\n";
+  s += fmt::format("set multiplot layout {},1 title '{}'\n", n, title);
+  for (int p = 0; p < n; ++p) {
+    s += fmt::format("set xlabel '{}'\nset ylabel '{}'\n", panels[p].xlabel, panels[p].ylabel);
+    std::string plot;
+    for (const auto& se : series) {
+      if (se.panel != p) continue;
+      plot += plot.empty() ? "plot " : ", ";
+      plot += fmt::format("'{}' using (column('{}')):(column('{}')) with lines title '{}'", csv_path, se.x_column,
+                          se.y_column, se.title);
+    }
+    s += plot + "\n";
+  }
+  s += "unset multiplot\n";
+  run_gnuplot(s, png_path);
+}
+
+}  // namespace lash::cli

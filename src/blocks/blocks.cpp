@@ -1,0 +1,66 @@
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "lash/blocks.hpp"
+
+namespace lash {
+namespace {
+void require(bool ok, const std::string& what) {
+  if (!ok) throw std::invalid_argument(what);
+}
+bool finite(double x) { return std::isfinite(x); }
+}  // namespace
+
+Deadzone::Deadzone(DeadzoneParams p) : p_(p) {
+  require(finite(p.left) && finite(p.right), "deadzone edges must be finite numbers");
+  require(p.left <= p.right, "deadzone needs left <= right (c_l <= c_r)");
+}
+
+Deadband::Deadband(PerSide<double> d) : d_(d) {
+  require(finite(d.left) && finite(d.right), "deadband half-width must be a finite number");
+  require(d.left >= 0 && d.right >= 0, "deadband half-width must be >= 0");
+}
+
+FirstOrderParams FirstOrderParams::from_continuous(double gain, double tau_s, double dt_s) {
+  require(finite(gain), "gain must be finite");
+  require(finite(tau_s) && tau_s > 0, "tau must be > 0");
+  require(finite(dt_s) && dt_s > 0, "dt must be > 0");
+  const double e = std::exp(-dt_s / tau_s);
+  return {-e, gain * (1.0 - e)};
+}
+
+double FirstOrderParams::tau_s(double dt_s) const noexcept { return -dt_s / std::log(-a1); }
+
+FirstOrder::FirstOrder(PerSide<FirstOrderParams> p) : p_(p) {
+  for (Side s : {Side::right, Side::left})
+    require(finite(p[s].a1) && finite(p[s].b1), std::string("linear ") + to_string(s) + " a1/b1 must be finite");
+}
+
+MovingAverage::MovingAverage(std::size_t length) {
+  require(length >= 1, "moving average length must be >= 1");
+  buf_.assign(length, 0.0);
+}
+void MovingAverage::reset() noexcept {
+  for (auto& v : buf_) v = 0.0;
+  pos_ = 0;
+  sum_ = comp_ = 0.0;
+}
+
+BackwardDifference::BackwardDifference(double dt_s) {
+  require(finite(dt_s) && dt_s > 0, "dt must be > 0");
+  dt_ = dt_s;
+}
+
+Delay::Delay(std::size_t samples) { buf_.assign(samples, 0.0); }
+void Delay::reset() noexcept {
+  for (auto& v : buf_) v = 0.0;
+  pos_ = 0;
+}
+
+Saturation::Saturation(double lower, double upper) : lo_(lower), hi_(upper) {
+  require(!std::isnan(lower) && !std::isnan(upper), "saturation limits must be numbers");
+  require(lower <= upper, "saturation needs lower <= upper");
+}
+
+}  // namespace lash
