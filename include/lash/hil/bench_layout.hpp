@@ -58,9 +58,13 @@ struct SensorMsg {
 struct BenchLayout {
   std::uint32_t command_id = 0x100, sensors_id = 0x200, cro_id = 0x7E0, dto_id = 0x7E1;
   std::uint8_t command_len = 8, sensors_len = 6, cro_len = 8;
-  BitField solenoid_a, solenoid_b, restrictor, command_counter;
-  BitField pilot, supply, sensor_counter;
-  BitField cro_cmd, cro_ctr, dto_pid, dto_err;
+  // Defaults: the layout of config/hydraulic_bench.dbc.
+  BitField solenoid_a{0, 16, true, 0.1, 0.0}, solenoid_b{16, 16, true, 0.1, 0.0}, restrictor{32, 16, true, 0.1, 0.0},
+      command_counter{48, 16, true, 1.0, 0.0};
+  BitField pilot{0, 16, true, 100.0 / 65535.0, 0.0}, supply{16, 16, true, 100.0 / 65535.0, 0.0},
+      sensor_counter{32, 16, true, 1.0, 0.0};
+  BitField cro_cmd{0, 8, true, 1.0, 0.0}, cro_ctr{8, 8, true, 1.0, 0.0}, dto_pid{0, 8, true, 1.0, 0.0},
+      dto_err{8, 8, true, 1.0, 0.0};
 
   /// Reads the layout from a DBC file. Throws lash::InputError naming the file and the
   /// missing message/signal (or a counter narrower than 8 bits). Not real-time safe.
