@@ -165,6 +165,8 @@ class MasterNode {
   bool step(can::Bus& bus, double now_s) noexcept;
 
   MasterState state() const noexcept { return state_; }
+  /// Control steps run so far (steps since the first CONNECT reply, fault steps included).
+  std::int64_t control_steps() const noexcept { return m_ + 1; }
   std::span<const MasterStepLog> log() const noexcept { return {log_.data(), n_log_}; }
   std::span<const MasterEvent> events() const noexcept { return {events_.data(), n_events_}; }
   std::span<const LoggedFrame> bus_log() const noexcept { return {bus_log_.data(), n_bus_log_}; }
