@@ -24,7 +24,6 @@
 #include "cli_common.hpp"
 #include "lash/can/bus.hpp"
 #include "lash/can/log.hpp"
-#include "lash/control/step_metrics.hpp"
 #include "lash/hil/netns.hpp"
 #include "lash/hil/nodes.hpp"
 #include "lash/hil/report.hpp"
@@ -419,7 +418,7 @@ int run_simulate(const SimulateOptions& o) {
   if (auto w = hil::find_step(c_r, s.step_s)) {
     std::vector<double> t(c_t.begin() + static_cast<std::ptrdiff_t>(w->begin), c_t.begin() + static_cast<std::ptrdiff_t>(w->end));
     std::vector<double> p(c_p.begin() + static_cast<std::ptrdiff_t>(w->begin), c_p.begin() + static_cast<std::ptrdiff_t>(w->end));
-    const StepMetrics sm = step_metrics(t, p, w->t_step_s, w->y0, w->y1);
+    const hil::StepResponse sm = hil::step_response(t, p, w->t_step_s, w->y0, w->y1);
     fmt::print("step {} -> {} kPa at t = {} s: 90% rise {:.4f} s, 10% settling {:.4f} s, overshoot {:.1f} %\n",
                format_double(w->y0), format_double(w->y1), format_double(w->t_step_s), sm.rise_s, sm.settling_s,
                sm.overshoot_pct);
@@ -591,13 +590,13 @@ int run_run(const RunOptions& o) {
   json step_json = json::object();
   const auto& p_slave = st["pressure_kPa"];
   const auto& y_slave = st["measured_kPa"];
-  std::optional<StepMetrics> sm, sm_meas;
+  std::optional<hil::StepResponse> sm, sm_meas;
   std::optional<hil::StepWindow> win = hil::find_step(ref, s.step_s);
   if (win && win->end <= p_slave.size()) {
     const auto b = static_cast<std::ptrdiff_t>(win->begin), e = static_cast<std::ptrdiff_t>(win->end);
     std::vector<double> t(t_m.begin() + b, t_m.begin() + e);
-    sm = step_metrics(t, std::vector<double>(p_slave.begin() + b, p_slave.begin() + e), win->t_step_s, win->y0, win->y1);
-    sm_meas = step_metrics(t, std::vector<double>(y_slave.begin() + b, y_slave.begin() + e), win->t_step_s, win->y0,
+    sm = hil::step_response(t, std::vector<double>(p_slave.begin() + b, p_slave.begin() + e), win->t_step_s, win->y0, win->y1);
+    sm_meas = hil::step_response(t, std::vector<double>(y_slave.begin() + b, y_slave.begin() + e), win->t_step_s, win->y0,
                            win->y1);
     step_json = {{"t_step_s", win->t_step_s}, {"from_kPa", win->y0}, {"to_kPa", win->y1},
                  {"rise_s", sm->rise_s},      {"settling_s", sm->settling_s}, {"overshoot_pct", sm->overshoot_pct},

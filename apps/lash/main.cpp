@@ -11,6 +11,8 @@ int main(int argc, char** argv) {
   std::vector<Command> commands{
       add_simulate(app),
       add_demo(app),
+      add_can(app),
+      add_hil(app),
   };
   try {
     app.parse(argc, argv);

@@ -23,6 +23,19 @@ struct StepWindow {
 };
 std::optional<StepWindow> find_step(const std::vector<double>& reference, double dt_s, double min_hold_s = 0.5);
 
+/// Thesis step-response figures of samples y at times t (t ≥ t_step), step y0 → y1:
+/// 90 % rise = first crossing of y0 + 0.9(y1 − y0) (interpolated), 10 % settling = last exit
+/// from |y − y1| ≤ 0.1|y1 − y0| (interpolated; 0 if never outside), overshoot = max over the
+/// window of (y − y1)/(y1 − y0) in percent (≥ 0). Times are measured from t_step. NaN rise
+/// when never reached.
+struct StepResponse {
+  double rise_s = 0.0;
+  double settling_s = 0.0;
+  double overshoot_pct = 0.0;
+};
+StepResponse step_response(const std::vector<double>& t_s, const std::vector<double>& y, double t_step_s, double y0,
+                           double y1);
+
 struct SimulationDiff {
   std::size_t compared = 0;               ///< control steps compared
   double max_abs_diff_kPa = 0.0;          ///< max |measured_emulated − measured_simulated|
