@@ -1,6 +1,7 @@
 // lash simulate: run a plant file open loop and write t,v,y,… as CSV.
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 
 #include <fmt/core.h>
 
@@ -23,7 +24,7 @@ struct SimulateOptions {
   double tau = 0.5;
   std::string steps;
   double duration = 10.0;
-  double dt = 0.0;
+  std::optional<double> dt;
   double noise_variance = 0.0;
   std::uint64_t seed = 1;
   std::string out;
@@ -50,7 +51,8 @@ std::vector<StepLevel> parse_steps(const std::string& text) {
 }
 
 int run(const SimulateOptions& o) {
-  Plant plant = load_plant(o.plant, o.dt);
+  if (o.dt && !(*o.dt > 0)) throw InputError("", 0, "--dt", "sample period must be > 0 [s]");
+  Plant plant = load_plant(o.plant, o.dt.value_or(0.0));
   SimulationSpec spec;
   try {
     spec.input.kind = parse_waveform(o.input);

@@ -26,8 +26,8 @@ FirstOrderParams FirstOrderParams::from_continuous(double gain, double tau_s, do
   require(finite(gain), "gain must be finite");
   require(finite(tau_s) && tau_s > 0, "tau must be > 0");
   require(finite(dt_s) && dt_s > 0, "dt must be > 0");
-  const double e = std::exp(-dt_s / tau_s);
-  return {-e, gain * (1.0 - e)};
+  const double x = -dt_s / tau_s;
+  return {-std::exp(x), -gain * std::expm1(x)};  // expm1: exact 1 − e^{−T/τ} for T ≪ τ
 }
 
 double FirstOrderParams::tau_s(double dt_s) const noexcept { return -dt_s / std::log(-a1); }
