@@ -52,8 +52,10 @@ kinds = [e[2] for e in events]
 print(events)
 assert kinds[:2] == ["ccp_connect_sent", "ccp_connected"], kinds
 assert "sensor_timeout_safe_state" in kinds and "sensor_resumed" in kinds, kinds
-fault_step = int(events[kinds.index("sensor_timeout_safe_state")][0])
-resume_step = int(events[kinds.index("sensor_resumed")][0])
+# The kill is the longest fault (a busy machine may add short ones: each is logged too).
+faults = [(int(e[0]), next(int(r[0]) for r in events[i:] if r[2] == "sensor_resumed"))
+          for i, e in enumerate(events) if e[2] == "sensor_timeout_safe_state"]
+fault_step, resume_step = max(faults, key=lambda f: f[1] - f[0])
 steps = [int(v) for v in m["step"]]
 row = {s: i for i, s in enumerate(steps)}
 # The last fresh sensor frame before the fault, then 0 mA within 3 periods.
