@@ -29,6 +29,7 @@ Command add_simulate(CLI::App& app);
 Command add_demo(CLI::App& app);
 Command add_estimate(CLI::App& app);
 Command add_can(CLI::App& app);
+Command add_hil(CLI::App& app);
 
 /// Runs `fn`, mapping InputError and std::invalid_argument to exit 2 with a message on stderr.
 int guarded(const std::function<int()>& fn);

@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
       add_demo(app),
       add_estimate(app),
       add_can(app),
+      add_hil(app),
   };
   try {
     app.parse(argc, argv);
