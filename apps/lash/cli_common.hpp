@@ -27,6 +27,7 @@ struct Command {
 /// Each subcommand file defines one of these.
 Command add_simulate(CLI::App& app);
 Command add_demo(CLI::App& app);
+Command add_estimate(CLI::App& app);
 Command add_sweep(CLI::App& app);
 Command add_can(CLI::App& app);
 Command add_hil(CLI::App& app);
