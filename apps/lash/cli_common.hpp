@@ -30,6 +30,7 @@ Command add_demo(CLI::App& app);
 Command add_closed_loop(CLI::App& app);
 Command add_tune(CLI::App& app);
 Command add_identify_steps(CLI::App& app);
+Command add_can(CLI::App& app);
 
 /// Runs `fn`, mapping InputError and std::invalid_argument to exit 2 with a message on stderr.
 int guarded(const std::function<int()>& fn);

@@ -1,0 +1,146 @@
+#pragma once
+/// @file codec.hpp
+/// Signal codec: physical ↔ raw ↔ payload bits for DBC signals up to 64 bits.
+///
+/// physical = raw × factor + offset (DBC). physical → raw rounds to nearest
+/// (ties to even, like canmatrix's Python `round`), never truncates. Values
+/// outside the signal's range — the DBC [min|max] when min < max, and always
+/// the range its bits can hold — are clamped, and each clamp is counted.
+///
+/// Real-time contract: decode()/encode()/read_raw()/write_raw() are noexcept,
+/// allocation-free and O(1). The bit routine (Intel or Motorola; one 8-byte
+/// window or the rare 9-byte span) is chosen once, at construction, as a
+/// function pointer — no virtual call and no per-sample layout decision.
+/// Every call takes a length-checked std::span and refuses spans too short for
+/// the signal. Constructors validate and are not real-time safe.
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "lash/can/dbc.hpp"
+
+namespace lash::can {
+
+class SignalCodec {
+ public:
+  /// Throws std::invalid_argument for a layout that cannot be coded (length 0/>64,
+  /// factor 0, float type with the wrong length, bits past byte 64).
+  explicit SignalCodec(const dbc::Signal& signal);
+
+  /// Bytes a payload must hold for this signal (highest byte touched + 1).
+  std::size_t min_bytes() const noexcept { return min_bytes_; }
+  const dbc::Signal& signal() const noexcept { return signal_; }
+
+  /// Raw bits (zero-extended, `length` bits) or nullopt when `data` is too short.
+  std::optional<std::uint64_t> read_raw(std::span<const std::uint8_t> data) const noexcept {
+    if (data.size() < min_bytes_) return std::nullopt;
+    return read_(*this, data.data(), data.size());
+  }
+  /// Writes the low `length` bits of `raw`, leaving other bits alone. False when `data` is too short.
+  bool write_raw(std::span<std::uint8_t> data, std::uint64_t raw) const noexcept {
+    if (data.size() < min_bytes_) return false;
+    write_(*this, data.data(), data.size(), raw & mask_);
+    return true;
+  }
+
+  /// raw bits → physical value (sign extension / IEEE float per the signal).
+  double to_physical(std::uint64_t raw) const noexcept;
+  /// physical → raw bits: round to nearest, clamp (sets `clamped`).
+  std::uint64_t to_raw(double physical, bool& clamped) const noexcept;
+
+  /// Physical value of the signal in `data`, or nullopt when `data` is too short.
+  std::optional<double> decode(std::span<const std::uint8_t> data) const noexcept {
+    auto raw = read_raw(data);
+    if (!raw) return std::nullopt;
+    return to_physical(*raw);
+  }
+  enum class Status : std::uint8_t { ok, clamped, too_short };
+  /// Encodes `physical` into `data`; counts a clamp.
+  Status encode(double physical, std::span<std::uint8_t> data) noexcept {
+    if (data.size() < min_bytes_) return Status::too_short;
+    bool clamped = false;
+    const std::uint64_t raw = to_raw(physical, clamped);
+    write_(*this, data.data(), data.size(), raw);
+    if (clamped) {
+      ++clamp_count_;
+      return Status::clamped;
+    }
+    return Status::ok;
+  }
+  std::uint64_t clamp_count() const noexcept { return clamp_count_; }
+
+ private:
+  using ReadFn = std::uint64_t (*)(const SignalCodec&, const std::uint8_t*, std::size_t) noexcept;
+  using WriteFn = void (*)(const SignalCodec&, std::uint8_t*, std::size_t, std::uint64_t) noexcept;
+  template <bool Motorola>
+  static std::uint64_t read_window(const SignalCodec& c, const std::uint8_t* d, std::size_t n) noexcept;
+  template <bool Motorola>
+  static void write_window(const SignalCodec& c, std::uint8_t* d, std::size_t n, std::uint64_t raw) noexcept;
+  template <bool Motorola>
+  static std::uint64_t read_bits(const SignalCodec& c, const std::uint8_t* d, std::size_t n) noexcept;
+  template <bool Motorola>
+  static void write_bits(const SignalCodec& c, std::uint8_t* d, std::size_t n, std::uint64_t raw) noexcept;
+
+  dbc::Signal signal_;
+  ReadFn read_ = nullptr;
+  WriteFn write_ = nullptr;
+  std::uint64_t mask_ = 0;       ///< low `length` bits
+  std::uint32_t first_byte_ = 0; ///< lowest byte touched
+  std::uint32_t min_bytes_ = 0;  ///< highest byte touched + 1
+  std::int32_t lo_base_ = 0;     ///< LSB position in a 64-bit window starting at byte 0 (see codec.cpp)
+  std::uint32_t length_ = 0;
+  bool signed_ = false;
+  dbc::ValueType type_ = dbc::ValueType::integer;
+  double factor_ = 1.0;
+  double offset_ = 0.0;
+  double min_phys_ = 0.0;
+  double max_phys_ = 0.0;
+  bool has_range_ = false;
+  double raw_lo_ = 0.0;       ///< smallest raw value (as double)
+  double raw_hi_excl_ = 0.0;  ///< raw values must be < this (2^len or 2^(len-1))
+  std::uint64_t clamp_count_ = 0;
+};
+
+/// All signals of one DBC message, with multiplexing.
+class MessageCodec {
+ public:
+  /// Throws std::invalid_argument (naming the signal) when a signal cannot be
+  /// coded or does not fit the message's size. Not real-time safe.
+  explicit MessageCodec(const dbc::Message& message);
+
+  const dbc::Message& message() const noexcept { return message_; }
+  std::size_t signal_count() const noexcept { return codecs_.size(); }
+  /// Index of a signal by name (not real-time safe).
+  std::optional<std::size_t> index_of(std::string_view signal_name) const noexcept;
+  const SignalCodec& codec(std::size_t i) const noexcept { return codecs_[i]; }
+
+  /// Decodes all signals into `values` (size == signal_count()). Multiplexed
+  /// signals not selected by the multiplexor's value come out as NaN.
+  /// False (values untouched) when a span is too short.
+  bool decode(std::span<const std::uint8_t> data, std::span<double> values) const noexcept;
+
+  struct EncodeResult {
+    bool ok = false;            ///< false: a span was too short, nothing written
+    std::uint32_t clamped = 0;  ///< signals clamped in this call
+  };
+  /// Encodes `values` (size == signal_count()) into `data` (size ≥ message size).
+  /// Multiplexed signals are written only when the multiplexor's encoded value
+  /// selects them; NaN values of multiplexed signals are skipped too.
+  EncodeResult encode(std::span<const double> values, std::span<std::uint8_t> data) noexcept;
+  /// Clamps counted over this codec's lifetime.
+  std::uint64_t clamp_count() const noexcept { return clamp_count_; }
+
+ private:
+  dbc::Message message_;
+  std::vector<SignalCodec> codecs_;
+  std::vector<std::uint64_t> mux_values_;  ///< per signal; meaningful when multiplexed
+  std::vector<std::uint8_t> multiplexed_;
+  std::size_t mux_index_ = 0;
+  bool has_mux_ = false;
+  std::uint64_t clamp_count_ = 0;
+};
+
+}  // namespace lash::can

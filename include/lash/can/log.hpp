@@ -1,0 +1,43 @@
+#pragma once
+/// @file log.hpp
+/// can-utils text forms of frames:
+///  - `ID#HEXDATA` (cansend): 3 hex digits = 11-bit id, 8 hex digits = 29-bit id;
+///    `ID#R` / `ID#R<dlc>` remote frames; `ID##<flags>HEXDATA` CAN FD;
+///  - `candump -L` log lines: `(seconds.microseconds) iface ID#HEXDATA` with six
+///    microsecond digits (an optional trailing ` R`/` T` direction, as python-can
+///    writes, is accepted). canplayer and python-can's CanutilsLogReader read them.
+/// Not real-time safe (strings).
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "lash/can/frame.hpp"
+
+namespace lash::can {
+
+/// Parses `ID#HEX`; returns nullopt and sets `error` on bad text. Never throws.
+std::optional<Frame> parse_frame_text(std::string_view text, std::string& error) noexcept;
+/// `123#DEADBEEF`, `12345678#00`, `123#R`, `123#R4`, `123##0AABB`.
+std::string format_frame_text(const Frame& frame);
+
+struct LogEntry {
+  Frame frame;            ///< frame.timestamp_s holds the log time [s]
+  std::string interface;  ///< e.g. "vcan0"
+};
+
+/// Parses one `candump -L` line. nullopt + `error` on bad text. Never throws.
+std::optional<LogEntry> parse_log_line(std::string_view line, std::string& error) noexcept;
+/// `(1600000000.123456) vcan0 123#DEADBEEF` (no newline); time rounded to 1 µs.
+std::string format_log_line(const Frame& frame, std::string_view interface);
+
+/// Reads a candump -L log. Blank lines are skipped. Throws lash::InputError
+/// naming file, line and field on the first bad line.
+std::vector<LogEntry> read_log(const std::filesystem::path& path);
+/// Parses log text (same rules as read_log; `file` names the source in errors).
+std::vector<LogEntry> parse_log(std::string_view text, const std::string& file = "<log>");
+/// Writes entries atomically (lash::AtomicFile).
+void write_log(const std::filesystem::path& path, const std::vector<LogEntry>& entries);
+
+}  // namespace lash::can

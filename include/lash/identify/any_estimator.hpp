@@ -1,0 +1,95 @@
+#pragma once
+/// @file any_estimator.hpp
+/// One type for every estimator of SPEC A4 (a std::variant, no virtual calls), plus a
+/// summary report and a batch runner used by `lash estimate`, `lash demo` and sweeps.
+#include <cstdint>
+#include <span>
+#include <string>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include "lash/identify/estimators.hpp"
+
+namespace lash {
+
+/// Summary of one side (or of the whole model for `linear`, kept in `right`).
+struct SideReport {
+  SideParams params;  ///< NaN = not identified (JSON null)
+  std::vector<std::pair<std::string, std::uint64_t>> updates;  ///< per key: "+"/"-" or "all"
+};
+
+/// What the estimator knows now. Not real-time safe (allocates).
+struct EstimateReport {
+  ModelKind model = ModelKind::linear;
+  std::uint64_t samples = 0;   ///< samples stepped (including skipped ones)
+  std::uint64_t skipped = 0;   ///< non-finite samples / updates skipped
+  bool identified = false;
+  bool has_c = false;          ///< model has a deadzone c per side
+  bool has_side_d = false;     ///< model has a deadband d per side
+  bool has_shared_d = false;   ///< coupled-carts: one d for both directions
+  SideReport right, left;      ///< linear: only `right` is meaningful
+  double d = std::numeric_limits<double>::quiet_NaN();  ///< coupled-carts
+  std::vector<std::pair<std::string, std::uint64_t>> d_updates;
+};
+
+class AnyEstimator {
+ public:
+  /// Validates the config (std::invalid_argument) and builds the estimator of cfg.model.
+  explicit AnyEstimator(const EstimatorConfig& cfg);
+
+  /// One sample; returns ŷ. noexcept, allocation-free.
+  double step(double v, double y) noexcept {
+    ++samples_;
+    return std::visit([&](auto& e) noexcept { return e.step(v, y); }, e_);
+  }
+  double prediction() const noexcept {
+    return std::visit([](const auto& e) noexcept { return e.prediction(); }, e_);
+  }
+  double simulated() const noexcept {
+    return std::visit([](const auto& e) noexcept { return e.simulated(); }, e_);
+  }
+  bool identified() const noexcept {
+    return std::visit([](const auto& e) noexcept { return e.identified(); }, e_);
+  }
+  /// Per-side parameters (linear: both sides return the single model).
+  SideParams params(Side s) const noexcept;
+
+  /// Names of the per-step parameter columns ("a1_r", "b1_r", "c_r", "d_r", …).
+  std::vector<std::string> param_names() const;
+  /// Current values in the order of param_names() (NaN = not identified). noexcept, no allocation.
+  void param_values(std::span<double> out) const noexcept;
+
+  EstimateReport report() const;
+  const EstimatorConfig& config() const noexcept { return cfg_; }
+  template <class E>
+  const E* get() const noexcept { return std::get_if<E>(&e_); }
+
+ private:
+  EstimatorConfig cfg_;
+  std::variant<LinearEstimator, InputDeadzoneEstimator, OutputDeadzoneEstimator, DeadzoneDeadbandEstimator,
+               CoupledCartsEstimator>
+      e_;
+  std::uint64_t samples_ = 0;
+};
+
+/// Result of running an estimator over a whole record.
+struct EstimationRun {
+  EstimateReport report;
+  std::vector<double> yhat, ysim;                 ///< per sample
+  std::vector<std::string> param_names;
+  std::vector<std::vector<double>> params;        ///< params[p][k] (only if keep_trace)
+};
+
+/// Steps `cfg`'s estimator through v, y (same length). keep_trace stores the parameters per step.
+EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> v, std::span<const double> y,
+                            bool keep_trace = false);
+
+/// NRMSE = RMS(y − y_sim) / max|y| over t ∈ [t0, t1] (SPEC A6); NaN if the window is empty.
+double nrmse(std::span<const double> t, std::span<const double> y, std::span<const double> ysim, double t0_s,
+             double t1_s);
+/// Count per 1000 samples of |y − ŷ| > 3σ over t ∈ [t0, t1] (SPEC A6).
+double outside_3sigma_per_1000(std::span<const double> t, std::span<const double> y, std::span<const double> yhat,
+                               double sigma, double t0_s, double t1_s);
+
+}  // namespace lash

@@ -1,0 +1,92 @@
+#pragma once
+/// @file config.hpp
+/// Settings shared by every estimator of SPEC A4/A5 (docs/identification.md).
+/// Plain structs; `validate()` is called once at construction and throws
+/// std::invalid_argument naming the offending field (the CLI turns that into exit 2).
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <string_view>
+
+#include "lash/identify/rls.hpp"
+
+namespace lash {
+
+enum class ModelKind : std::uint8_t { linear, input_deadzone, output_deadzone, deadzone_deadband, coupled_carts };
+
+/// "linear", "input-deadzone", "output-deadzone", "deadzone-deadband", "coupled-carts";
+/// throws std::invalid_argument otherwise.
+ModelKind parse_model_kind(std::string_view name);
+const char* to_string(ModelKind m) noexcept;
+
+/// How each keyed regression is solved.
+enum class EstimationMethod : std::uint8_t {
+  ls,  ///< recursive least squares (eq. 13–16), the thesis's method
+  iv   ///< recursive instrumental variables, instrument = output delayed `iv_delay` more samples
+};
+EstimationMethod parse_method(std::string_view name);
+const char* to_string(EstimationMethod m) noexcept;
+
+/// Settings of every RLS inside an estimator (thesis §1.5.1: λ = 0.99, P0 = 1000·I, η0 = [1 1 1]).
+/// Parameter order is [a1, b1, e] (SPEC A4); the linear model uses the first two.
+struct RlsSettings {
+  double lambda = 0.99;
+  double p0 = 1000.0;
+  std::array<double, 3> eta0{1.0, 1.0, 1.0};
+  Forgetting forgetting = Forgetting::exponential;
+  double trace_max = 1e12;
+  std::array<double, 3> lower{-std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+                              -std::numeric_limits<double>::infinity()};
+  std::array<double, 3> upper{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+                              std::numeric_limits<double>::infinity()};
+};
+
+/// Noise handling of SPEC A5 / thesis §1.4.5. Defaults pass the signals through untouched.
+struct NoiseSettings {
+  /// M-point moving average on y (the regression output) [samples]; 1 = off.
+  std::size_t filter_length = 1;
+  /// Pass v through the same moving average as y ("consistent filtering": the linear
+  /// relation between v and y survives the filter wherever its window stays in one regime).
+  bool filter_input = false;
+  /// Pure delay of v [samples] that keeps v aligned with a filtered y when v itself is not filtered.
+  std::size_t input_delay = 0;
+  /// M-point moving average on the backward-difference derivative ẏ [samples]; 1 = off.
+  std::size_t derivative_filter_length = 1;
+  /// Dead band on ẏ: |ẏ| ≤ threshold counts as "not moving" [y unit/s]. 0 = sign of the difference.
+  double derivative_threshold = 0.0;
+  /// Delay of the regression signals (v and y after the filters above) so that they line up
+  /// with the filtered ẏ used for switching [samples]. Typically (derivative_filter_length − 1)/2.
+  std::size_t align_delay = 0;
+};
+
+struct EstimatorConfig {
+  ModelKind model = ModelKind::deadzone_deadband;
+  double dt_s = 0.005;                                  ///< sample period T [s]
+  double guess_left = -std::numeric_limits<double>::infinity();   ///< c_l* [v unit] (input-side switching)
+  double guess_right = std::numeric_limits<double>::infinity();   ///< c_r* [v unit]
+  RlsSettings rls;
+  NoiseSettings noise;
+  EstimationMethod method = EstimationMethod::ls;
+  std::size_t iv_delay = 2;        ///< iv: the instrument for y(k−1) is y(k−1−iv_delay) [samples]
+  /// deadzone-deadband: one 4-parameter regression per side with a1, b1 shared between
+  /// directions (η = [a1, b1, −b1·c, d(1+a1)]) instead of the thesis's separate + and − RLS.
+  bool pooled = false;
+  std::uint64_t min_updates = 10;  ///< a key needs this many updates before its side is identified
+  double singular_tol = 1e-6;      ///< eq. 31/32: |det| below tol·(|a|+|b|) terms counts as singular
+  double zero_threshold = 0.0;     ///< output-deadzone: |y| ≤ this counts as 0 [y unit]
+  double accel_limit = std::numeric_limits<double>::infinity();  ///< coupled-carts stage 1: max |ÿ| [y unit/s²]
+  double stage2_start_s = 7.5;     ///< coupled-carts: deadband estimation starts here [s]
+  /// Free-run simulation inside the input deadzone: false = keep the a1 of the side last used
+  /// (thesis §1.4.2, SPEC A4); true = side by the sign of v(k−1) (eq. 34).
+  bool sim_side_by_sign = false;
+
+  /// Throws std::invalid_argument naming the field.
+  void validate() const;
+  RlsConfig<3> rls3() const;
+  RlsConfig<2> rls2() const;
+  RlsConfig<4> rls4() const;
+};
+
+}  // namespace lash

@@ -1,0 +1,42 @@
+#pragma once
+/// @file data.hpp
+/// Loading a measured record as named numeric columns, independent of the file format.
+/// CSV is built in; other formats (e.g. MAT files) plug in with register_column_reader().
+/// Not real-time safe. Errors are lash::InputError naming file, line (where there is one) and column.
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace lash {
+
+/// Columns in the order they were asked for, all of the same length.
+struct ColumnData {
+  std::string file;
+  std::vector<std::string> names;
+  std::vector<std::vector<double>> cols;
+  std::vector<int> line_of_row;  ///< 1-based source line of each row (empty when the format has no lines)
+  std::size_t rows() const noexcept { return cols.empty() ? 0 : cols[0].size(); }
+};
+
+/// A reader returns exactly the requested columns (throwing InputError for a missing one).
+using ColumnReader = std::function<ColumnData(const std::filesystem::path& path, const std::vector<std::string>& names)>;
+
+/// Registers a reader for a lower-case file extension with the dot (".mat"). Replaces an earlier one.
+void register_column_reader(const std::string& extension, ColumnReader reader);
+
+/// Reads `names` from `path` with the reader registered for its extension, CSV otherwise.
+ColumnData load_columns(const std::filesystem::path& path, const std::vector<std::string>& names);
+
+/// Loads t, v, y for estimation: `names` = {t, v, y} column names; checks that t is strictly
+/// increasing (InputError naming the line) and returns the sample period (mean step of t).
+struct Record {
+  ColumnData data;
+  double dt_s = 0.0;
+  const std::vector<double>& t() const { return data.cols[0]; }
+  const std::vector<double>& v() const { return data.cols[1]; }
+  const std::vector<double>& y() const { return data.cols[2]; }
+};
+Record load_record(const std::filesystem::path& path, const std::vector<std::string>& names);
+
+}  // namespace lash

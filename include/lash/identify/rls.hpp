@@ -1,0 +1,203 @@
+#pragma once
+/// @file rls.hpp
+/// Recursive least squares with forgetting (thesis eq. 13–16, Åström & Wittenmark),
+/// fixed size N, allocation-free and noexcept on the sample path.
+///
+/// Safety measures (docs/identification.md):
+///  - P is kept exactly symmetric (upper triangle computed, mirrored).
+///  - P stays bounded when excitation vanishes: either *directional forgetting*
+///    (Kulhavý 1987; Bittanti, Bolzern & Campi 1990; form of Cao & Schwartz 2000),
+///    which forgets only along the current regressor, or exponential forgetting with a
+///    *trace bound* (the 1/λ inflation is skipped whenever it would take trace P above
+///    `trace_max`; Åström & Wittenmark, Adaptive Control, 2nd ed., §11.2).
+///  - an update with a non-finite φ or y is skipped and counted; the state is untouched.
+///  - optional per-parameter bounds: the estimate is projected (clamped) onto the box
+///    after each update (Goodwin & Sin 1984, §3.7).
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace lash {
+
+enum class Forgetting : std::uint8_t {
+  exponential,  ///< eq. 15–16 with λ, plus the trace bound
+  directional   ///< Bittanti et al. (1990) directional forgetting with factor λ
+};
+
+template <std::size_t N>
+struct RlsConfig {
+  double lambda = 1.0;  ///< forgetting factor λ ∈ (0, 1]
+  double p0 = 1000.0;   ///< P(0) = p0·I
+  std::array<double, N> eta0{};  ///< η̂(0)
+  Forgetting forgetting = Forgetting::exponential;
+  /// Exponential forgetting: upper bound on trace P (the 1/λ inflation stops there).
+  double trace_max = 1e12;
+  std::array<double, N> lower = filled(-std::numeric_limits<double>::infinity());  ///< projection box
+  std::array<double, N> upper = filled(std::numeric_limits<double>::infinity());
+
+  static constexpr std::array<double, N> filled(double x) {
+    std::array<double, N> a{};
+    for (auto& v : a) v = x;
+    return a;
+  }
+  /// Throws std::invalid_argument naming the offending setting.
+  void validate() const {
+    if (!(lambda > 0.0 && lambda <= 1.0)) throw std::invalid_argument("lambda must be in (0, 1]");
+    if (!(std::isfinite(p0) && p0 > 0.0)) throw std::invalid_argument("p0 must be > 0 and finite");
+    if (!(trace_max > 0.0)) throw std::invalid_argument("trace_max must be > 0");
+    for (std::size_t i = 0; i < N; ++i) {
+      if (!std::isfinite(eta0[i])) throw std::invalid_argument("eta0 must be finite");
+      if (std::isnan(lower[i]) || std::isnan(upper[i]) || lower[i] > upper[i])
+        throw std::invalid_argument("parameter bounds need lower <= upper (index " + std::to_string(i) + ")");
+    }
+  }
+};
+
+template <std::size_t N>
+class Rls {
+ public:
+  using Vec = std::array<double, N>;
+  using Mat = std::array<std::array<double, N>, N>;
+
+  /// Not real-time safe only in that it may throw (invalid config).
+  explicit Rls(const RlsConfig<N>& cfg = {}) : cfg_(cfg) {
+    cfg_.validate();
+    reset();
+  }
+
+  void reset() noexcept {
+    eta_ = cfg_.eta0;
+    project();
+    for (std::size_t i = 0; i < N; ++i)
+      for (std::size_t j = 0; j < N; ++j) p_[i][j] = i == j ? cfg_.p0 : 0.0;
+    updates_ = 0;
+    skipped_ = 0;
+  }
+
+  /// ŷ = φᵀη̂ (eq. 14) with the current estimate.
+  double predict(const Vec& phi) const noexcept {
+    double s = 0.0;
+    for (std::size_t i = 0; i < N; ++i) s += phi[i] * eta_[i];
+    return s;
+  }
+
+  /// One RLS step (eq. 13–16). Returns the a-priori prediction ŷ = φᵀη̂(k−1);
+  /// a non-finite φ or y leaves the state untouched, counts the skip and returns NaN.
+  double update(const Vec& phi, double y) noexcept {
+    if (!finite(phi, y)) {
+      ++skipped_;
+      return std::numeric_limits<double>::quiet_NaN();
+    }
+    const double yhat = predict(phi);
+    Vec pphi{};  // P φ
+    for (std::size_t i = 0; i < N; ++i) {
+      double s = 0.0;
+      for (std::size_t j = 0; j < N; ++j) s += p_[i][j] * phi[j];
+      pphi[i] = s;
+    }
+    double r = 0.0;  // φᵀ P φ
+    for (std::size_t i = 0; i < N; ++i) r += phi[i] * pphi[i];
+    const double err = y - yhat;
+    if (cfg_.forgetting == Forgetting::exponential) {
+      // eq. 16: q = Pφ / (λ + φᵀPφ); eq. 13: η += q e; eq. 15: P = (P − q φᵀ P)/λ
+      const double inv = 1.0 / (cfg_.lambda + r);
+      for (std::size_t i = 0; i < N; ++i) eta_[i] += pphi[i] * inv * err;
+      double tr = 0.0;
+      for (std::size_t i = 0; i < N; ++i) tr += p_[i][i] - pphi[i] * pphi[i] * inv;
+      const double scale = tr > cfg_.trace_max * cfg_.lambda ? 1.0 : 1.0 / cfg_.lambda;
+      for (std::size_t i = 0; i < N; ++i)
+        for (std::size_t j = i; j < N; ++j) p_[i][j] = (p_[i][j] - pphi[i] * pphi[j] * inv) * scale;
+    } else {
+      // Directional forgetting (Bittanti, Bolzern & Campi 1990; Cao & Schwartz 2000):
+      // q = Pφ/(1 + r); P = P − Pφφᵀ P/(β⁻¹ + r), β = λ − (1 − λ)/r; P unchanged when r = 0.
+      const double inv = 1.0 / (1.0 + r);
+      for (std::size_t i = 0; i < N; ++i) eta_[i] += pphi[i] * inv * err;
+      if (r > 0.0) {
+        const double beta = cfg_.lambda - (1.0 - cfg_.lambda) / r;
+        // 1/(β⁻¹ + r) = β/(1 + βr); 1 + βr = λ(1 + r) > 0 always.
+        const double g = beta / (1.0 + beta * r);
+        for (std::size_t i = 0; i < N; ++i)
+          for (std::size_t j = i; j < N; ++j) p_[i][j] -= pphi[i] * pphi[j] * g;
+      }
+    }
+    for (std::size_t i = 0; i < N; ++i)
+      for (std::size_t j = 0; j < i; ++j) p_[i][j] = p_[j][i];
+    project();
+    ++updates_;
+    return yhat;
+  }
+
+  /// Recursive instrumental-variable step (Young 1970; Söderström & Stoica 1989, §8):
+  /// q = Pz/(λ + φᵀPz), η += q(y − φᵀη), P = (P − qφᵀP)/λ. P is not symmetric in this
+  /// mode (it estimates (Σ z φᵀ)⁻¹). Exponential forgetting and the trace bound apply.
+  double update_iv(const Vec& phi, const Vec& z, double y) noexcept {
+    if (!finite(phi, y) || !finite(z, 0.0)) {
+      ++skipped_;
+      return std::numeric_limits<double>::quiet_NaN();
+    }
+    const double yhat = predict(phi);
+    Vec pz{}, phip{};  // P z and φᵀ P
+    for (std::size_t i = 0; i < N; ++i) {
+      double s = 0.0, t = 0.0;
+      for (std::size_t j = 0; j < N; ++j) {
+        s += p_[i][j] * z[j];
+        t += phi[j] * p_[j][i];
+      }
+      pz[i] = s;
+      phip[i] = t;
+    }
+    double r = 0.0;
+    for (std::size_t i = 0; i < N; ++i) r += phi[i] * pz[i];
+    const double den = cfg_.lambda + r;
+    if (!(std::fabs(den) > 1e-300)) {
+      ++skipped_;
+      return yhat;
+    }
+    const double inv = 1.0 / den;
+    const double err = y - yhat;
+    for (std::size_t i = 0; i < N; ++i) eta_[i] += pz[i] * inv * err;
+    double tr = 0.0;
+    for (std::size_t i = 0; i < N; ++i) tr += p_[i][i] - pz[i] * phip[i] * inv;
+    const double scale = tr > cfg_.trace_max * cfg_.lambda ? 1.0 : 1.0 / cfg_.lambda;
+    for (std::size_t i = 0; i < N; ++i)
+      for (std::size_t j = 0; j < N; ++j) p_[i][j] = (p_[i][j] - pz[i] * phip[j] * inv) * scale;
+    project();
+    ++updates_;
+    return yhat;
+  }
+
+  const Vec& eta() const noexcept { return eta_; }
+  double eta(std::size_t i) const noexcept { return eta_[i]; }
+  const Mat& P() const noexcept { return p_; }
+  double trace() const noexcept {
+    double t = 0.0;
+    for (std::size_t i = 0; i < N; ++i) t += p_[i][i];
+    return t;
+  }
+  std::uint64_t updates() const noexcept { return updates_; }
+  std::uint64_t skipped() const noexcept { return skipped_; }
+  const RlsConfig<N>& config() const noexcept { return cfg_; }
+
+ private:
+  static bool finite(const Vec& phi, double y) noexcept {
+    bool ok = std::isfinite(y);
+    for (std::size_t i = 0; i < N; ++i) ok = ok && std::isfinite(phi[i]);
+    return ok;
+  }
+  void project() noexcept {
+    for (std::size_t i = 0; i < N; ++i)
+      eta_[i] = eta_[i] < cfg_.lower[i] ? cfg_.lower[i] : (eta_[i] > cfg_.upper[i] ? cfg_.upper[i] : eta_[i]);
+  }
+
+  RlsConfig<N> cfg_;
+  Vec eta_{};
+  Mat p_{};
+  std::uint64_t updates_ = 0;
+  std::uint64_t skipped_ = 0;
+};
+
+}  // namespace lash

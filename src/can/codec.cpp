@@ -1,0 +1,284 @@
+// Signal codec. Bit numbering:
+//  - Intel (@1): payload bit k is bit k%8 of byte k/8; the field's LSB is at start_bit.
+//  - Motorola (@0): start_bit names the MSB in the DBC sawtooth numbering. With
+//    q = 8*(start/8) + 7 - start%8 the big-endian linear index (0 = MSB of byte 0),
+//    the field occupies big-endian bits q .. q+len-1.
+// A field spanning at most 8 bytes is read from one 64-bit window (little- or
+// big-endian load) as (word >> lo) & mask; fields spanning 9 bytes (len ≥ 58,
+// unaligned) use a bit loop. The routine is picked once in the constructor.
+#include "lash/can/codec.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+
+#include <fmt/core.h>
+
+namespace lash::can {
+namespace {
+
+inline std::uint64_t load64(const std::uint8_t* p, bool big_endian) noexcept {
+  std::uint64_t w;
+  std::memcpy(&w, p, 8);
+  const bool swap = big_endian == (std::endian::native == std::endian::little);
+  return swap ? __builtin_bswap64(w) : w;
+}
+inline void store64(std::uint8_t* p, std::uint64_t w, bool big_endian) noexcept {
+  const bool swap = big_endian == (std::endian::native == std::endian::little);
+  if (swap) w = __builtin_bswap64(w);
+  std::memcpy(p, &w, 8);
+}
+
+}  // namespace
+
+template <bool Motorola>
+std::uint64_t SignalCodec::read_window(const SignalCodec& c, const std::uint8_t* d, std::size_t n) noexcept {
+  std::uint64_t word = 0;
+  std::uint32_t w = 0;
+  if (n >= 8) {
+    w = std::min<std::uint32_t>(c.first_byte_, static_cast<std::uint32_t>(n - 8));
+    word = load64(d + w, Motorola);
+  } else {
+    for (std::size_t i = 0; i < n; ++i)
+      word |= static_cast<std::uint64_t>(d[i]) << (Motorola ? 56 - 8 * i : 8 * i);
+  }
+  const std::int32_t lo = Motorola ? c.lo_base_ + 8 * static_cast<std::int32_t>(w)
+                                   : c.lo_base_ - 8 * static_cast<std::int32_t>(w);
+  return (word >> lo) & c.mask_;
+}
+
+template <bool Motorola>
+void SignalCodec::write_window(const SignalCodec& c, std::uint8_t* d, std::size_t n, std::uint64_t raw) noexcept {
+  std::uint64_t word = 0;
+  std::uint32_t w = 0;
+  if (n >= 8) {
+    w = std::min<std::uint32_t>(c.first_byte_, static_cast<std::uint32_t>(n - 8));
+    word = load64(d + w, Motorola);
+  } else {
+    for (std::size_t i = 0; i < n; ++i)
+      word |= static_cast<std::uint64_t>(d[i]) << (Motorola ? 56 - 8 * i : 8 * i);
+  }
+  const std::int32_t lo = Motorola ? c.lo_base_ + 8 * static_cast<std::int32_t>(w)
+                                   : c.lo_base_ - 8 * static_cast<std::int32_t>(w);
+  word = (word & ~(c.mask_ << lo)) | (raw << lo);
+  if (n >= 8) {
+    store64(d + w, word, Motorola);
+  } else {
+    for (std::size_t i = 0; i < n; ++i)
+      d[i] = static_cast<std::uint8_t>(word >> (Motorola ? 56 - 8 * i : 8 * i));
+  }
+}
+
+template <bool Motorola>
+std::uint64_t SignalCodec::read_bits(const SignalCodec& c, const std::uint8_t* d, std::size_t) noexcept {
+  std::uint64_t raw = 0;
+  const std::uint32_t len = c.length_;
+  const std::uint32_t start = c.signal_.start_bit;
+  const std::uint32_t q = 8 * (start / 8) + 7 - start % 8;
+  for (std::uint32_t i = 0; i < len; ++i) {
+    std::uint32_t byte, bit;
+    if (Motorola) {
+      const std::uint32_t p = q + (len - 1 - i);
+      byte = p / 8;
+      bit = 7 - p % 8;
+    } else {
+      byte = (start + i) / 8;
+      bit = (start + i) % 8;
+    }
+    raw |= static_cast<std::uint64_t>((d[byte] >> bit) & 1u) << i;
+  }
+  return raw;
+}
+
+template <bool Motorola>
+void SignalCodec::write_bits(const SignalCodec& c, std::uint8_t* d, std::size_t, std::uint64_t raw) noexcept {
+  const std::uint32_t len = c.length_;
+  const std::uint32_t start = c.signal_.start_bit;
+  const std::uint32_t q = 8 * (start / 8) + 7 - start % 8;
+  for (std::uint32_t i = 0; i < len; ++i) {
+    std::uint32_t byte, bit;
+    if (Motorola) {
+      const std::uint32_t p = q + (len - 1 - i);
+      byte = p / 8;
+      bit = 7 - p % 8;
+    } else {
+      byte = (start + i) / 8;
+      bit = (start + i) % 8;
+    }
+    const auto m = static_cast<std::uint8_t>(1u << bit);
+    if ((raw >> i) & 1u) {
+      d[byte] = static_cast<std::uint8_t>(d[byte] | m);
+    } else {
+      d[byte] = static_cast<std::uint8_t>(d[byte] & ~m);
+    }
+  }
+}
+
+SignalCodec::SignalCodec(const dbc::Signal& s) : signal_(s) {
+  const auto bad = [&](const std::string& why) {
+    return std::invalid_argument(fmt::format("signal '{}': {}", s.name, why));
+  };
+  if (s.length < 1 || s.length > 64) throw bad("length must be 1..64 bits");
+  if (!(s.factor != 0.0) || !std::isfinite(s.factor) || !std::isfinite(s.offset)) throw bad("factor must be finite and non-zero");
+  if (s.value_type == dbc::ValueType::float32 && s.length != 32) throw bad("a float signal needs 32 bits");
+  if (s.value_type == dbc::ValueType::float64 && s.length != 64) throw bad("a double signal needs 64 bits");
+  length_ = s.length;
+  signed_ = s.is_signed;
+  type_ = s.value_type;
+  factor_ = s.factor;
+  offset_ = s.offset;
+  min_phys_ = s.minimum;
+  max_phys_ = s.maximum;
+  has_range_ = s.minimum < s.maximum;
+  mask_ = length_ == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << length_) - 1;
+  if (signed_) {
+    raw_lo_ = -std::ldexp(1.0, static_cast<int>(length_) - 1);
+    raw_hi_excl_ = std::ldexp(1.0, static_cast<int>(length_) - 1);
+  } else {
+    raw_lo_ = 0.0;
+    raw_hi_excl_ = std::ldexp(1.0, static_cast<int>(length_));
+  }
+  const bool motorola = s.byte_order == dbc::ByteOrder::motorola;
+  std::uint32_t b0, b1;
+  if (motorola) {
+    const std::uint32_t q = 8 * (s.start_bit / 8) + 7 - s.start_bit % 8;
+    const std::uint32_t lsb = q + length_ - 1;
+    if (lsb >= 512) throw bad("bits run past byte 64");
+    b0 = q / 8;
+    b1 = lsb / 8;
+    lo_base_ = 63 - static_cast<std::int32_t>(lsb);
+  } else {
+    if (s.start_bit + length_ > 512) throw bad("bits run past byte 64");
+    b0 = s.start_bit / 8;
+    b1 = (s.start_bit + length_ - 1) / 8;
+    lo_base_ = static_cast<std::int32_t>(s.start_bit);
+  }
+  first_byte_ = b0;
+  min_bytes_ = b1 + 1;
+  if (b1 - b0 + 1 <= 8) {
+    read_ = motorola ? &read_window<true> : &read_window<false>;
+    write_ = motorola ? &write_window<true> : &write_window<false>;
+  } else {
+    read_ = motorola ? &read_bits<true> : &read_bits<false>;
+    write_ = motorola ? &write_bits<true> : &write_bits<false>;
+  }
+}
+
+double SignalCodec::to_physical(std::uint64_t raw) const noexcept {
+  double v;
+  switch (type_) {
+    case dbc::ValueType::float32:
+      v = static_cast<double>(std::bit_cast<float>(static_cast<std::uint32_t>(raw)));
+      break;
+    case dbc::ValueType::float64:
+      v = std::bit_cast<double>(raw);
+      break;
+    default:
+      if (signed_) {
+        const int sh = 64 - static_cast<int>(length_);
+        v = static_cast<double>(static_cast<std::int64_t>(raw << sh) >> sh);
+      } else {
+        v = static_cast<double>(raw);
+      }
+  }
+  return v * factor_ + offset_;
+}
+
+std::uint64_t SignalCodec::to_raw(double physical, bool& clamped) const noexcept {
+  clamped = false;
+  if (std::isnan(physical)) {
+    clamped = true;
+    return 0;
+  }
+  double p = physical;
+  if (has_range_) {
+    if (p < min_phys_) {
+      p = min_phys_;
+      clamped = true;
+    } else if (p > max_phys_) {
+      p = max_phys_;
+      clamped = true;
+    }
+  }
+  const double scaled = (p - offset_) / factor_;
+  if (type_ == dbc::ValueType::float32) {
+    const auto f = static_cast<float>(scaled);
+    if (std::isinf(f) && !std::isinf(scaled)) clamped = true;
+    return std::bit_cast<std::uint32_t>(f);
+  }
+  if (type_ == dbc::ValueType::float64) return std::bit_cast<std::uint64_t>(scaled);
+  const double r = std::nearbyint(scaled);  // round to nearest, ties to even
+  if (r < raw_lo_) {
+    clamped = true;
+    return signed_ ? (std::uint64_t{1} << (length_ - 1)) & mask_ : 0;  // most negative
+  }
+  if (r >= raw_hi_excl_) {
+    clamped = true;
+    return signed_ ? mask_ >> 1 : mask_;
+  }
+  if (signed_) return static_cast<std::uint64_t>(static_cast<std::int64_t>(r)) & mask_;
+  return static_cast<std::uint64_t>(r);
+}
+
+MessageCodec::MessageCodec(const dbc::Message& message) : message_(message) {
+  codecs_.reserve(message.signals.size());
+  for (std::size_t i = 0; i < message.signals.size(); ++i) {
+    const auto& s = message.signals[i];
+    codecs_.emplace_back(s);
+    if (codecs_.back().min_bytes() > message.size)
+      throw std::invalid_argument(fmt::format("message '{}': signal '{}' needs {} bytes but the message has {}",
+                                              message.name, s.name, codecs_.back().min_bytes(), message.size));
+    mux_values_.push_back(s.mux_value);
+    multiplexed_.push_back(s.mux == dbc::MuxRole::multiplexed ? 1 : 0);
+    if (s.mux == dbc::MuxRole::multiplexor) {
+      has_mux_ = true;
+      mux_index_ = i;
+    }
+  }
+  for (std::size_t i = 0; i < multiplexed_.size(); ++i)
+    if (multiplexed_[i] && !has_mux_)
+      throw std::invalid_argument(fmt::format("message '{}': signal '{}' is multiplexed but there is no multiplexor",
+                                              message.name, message.signals[i].name));
+}
+
+std::optional<std::size_t> MessageCodec::index_of(std::string_view signal_name) const noexcept {
+  for (std::size_t i = 0; i < codecs_.size(); ++i)
+    if (codecs_[i].signal().name == signal_name) return i;
+  return std::nullopt;
+}
+
+bool MessageCodec::decode(std::span<const std::uint8_t> data, std::span<double> values) const noexcept {
+  if (values.size() != codecs_.size() || data.size() < message_.size) return false;
+  std::uint64_t mux = 0;
+  if (has_mux_) mux = *codecs_[mux_index_].read_raw(data);
+  for (std::size_t i = 0; i < codecs_.size(); ++i) {
+    if (multiplexed_[i] && mux_values_[i] != mux) {
+      values[i] = std::numeric_limits<double>::quiet_NaN();
+      continue;
+    }
+    values[i] = *codecs_[i].decode(data);
+  }
+  return true;
+}
+
+MessageCodec::EncodeResult MessageCodec::encode(std::span<const double> values, std::span<std::uint8_t> data) noexcept {
+  EncodeResult res;
+  if (values.size() != codecs_.size() || data.size() < message_.size) return res;
+  std::uint64_t mux = 0;
+  if (has_mux_) {
+    bool ignored = false;
+    mux = codecs_[mux_index_].to_raw(values[mux_index_], ignored);
+  }
+  for (std::size_t i = 0; i < codecs_.size(); ++i) {
+    if (multiplexed_[i] && (mux_values_[i] != mux || std::isnan(values[i]))) continue;
+    if (codecs_[i].encode(values[i], data) == SignalCodec::Status::clamped) ++res.clamped;
+  }
+  clamp_count_ += res.clamped;
+  res.ok = true;
+  return res;
+}
+
+}  // namespace lash::can

@@ -1,0 +1,148 @@
+#include "lash/identify/any_estimator.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace lash {
+
+namespace {
+using Var = std::variant<LinearEstimator, InputDeadzoneEstimator, OutputDeadzoneEstimator, DeadzoneDeadbandEstimator,
+                         CoupledCartsEstimator>;
+Var make(const EstimatorConfig& c) {
+  switch (c.model) {
+    case ModelKind::linear: return Var(std::in_place_type<LinearEstimator>, c);
+    case ModelKind::input_deadzone: return Var(std::in_place_type<InputDeadzoneEstimator>, c);
+    case ModelKind::output_deadzone: return Var(std::in_place_type<OutputDeadzoneEstimator>, c);
+    case ModelKind::deadzone_deadband: return Var(std::in_place_type<DeadzoneDeadbandEstimator>, c);
+    case ModelKind::coupled_carts: return Var(std::in_place_type<CoupledCartsEstimator>, c);
+  }
+  throw std::invalid_argument("unknown model");
+}
+}  // namespace
+
+AnyEstimator::AnyEstimator(const EstimatorConfig& cfg) : cfg_(cfg), e_(make(cfg)) {}
+
+SideParams AnyEstimator::params(Side s) const noexcept {
+  if (const auto* e = std::get_if<LinearEstimator>(&e_)) return e->params();
+  return std::visit(
+      [&](const auto& e) noexcept -> SideParams {
+        if constexpr (std::is_same_v<std::decay_t<decltype(e)>, LinearEstimator>) return e.params();
+        else return e.params(s);
+      },
+      e_);
+}
+
+std::vector<std::string> AnyEstimator::param_names() const {
+  switch (cfg_.model) {
+    case ModelKind::linear: return {"a1", "b1"};
+    case ModelKind::input_deadzone:
+    case ModelKind::output_deadzone: return {"a1_r", "b1_r", "c_r", "a1_l", "b1_l", "c_l"};
+    case ModelKind::deadzone_deadband: return {"a1_r", "b1_r", "c_r", "d_r", "a1_l", "b1_l", "c_l", "d_l"};
+    case ModelKind::coupled_carts: return {"a1_r", "b1_r", "c_r", "a1_l", "b1_l", "c_l", "d"};
+  }
+  return {};
+}
+
+void AnyEstimator::param_values(std::span<double> out) const noexcept {
+  const SideParams r = params(Side::right), l = params(Side::left);
+  std::size_t i = 0;
+  auto put = [&](double x) noexcept {
+    if (i < out.size()) out[i++] = x;
+  };
+  switch (cfg_.model) {
+    case ModelKind::linear: put(r.a1); put(r.b1); break;
+    case ModelKind::input_deadzone:
+    case ModelKind::output_deadzone:
+      put(r.a1); put(r.b1); put(r.c); put(l.a1); put(l.b1); put(l.c);
+      break;
+    case ModelKind::deadzone_deadband:
+      put(r.a1); put(r.b1); put(r.c); put(r.d); put(l.a1); put(l.b1); put(l.c); put(l.d);
+      break;
+    case ModelKind::coupled_carts:
+      put(r.a1); put(r.b1); put(r.c); put(l.a1); put(l.b1); put(l.c); put(r.d);
+      break;
+  }
+}
+
+EstimateReport AnyEstimator::report() const {
+  EstimateReport rep;
+  rep.model = cfg_.model;
+  rep.samples = samples_;
+  rep.identified = identified();
+  rep.right.params = params(Side::right);
+  rep.left.params = params(Side::left);
+  std::visit(
+      [&](const auto& e) {
+        using E = std::decay_t<decltype(e)>;
+        rep.skipped = e.skipped();
+        if constexpr (std::is_same_v<E, LinearEstimator>) {
+          rep.right.updates = {{"all", e.updates()}};
+        } else if constexpr (std::is_same_v<E, DeadzoneDeadbandEstimator>) {
+          rep.has_c = rep.has_side_d = true;
+          rep.right.updates = {{"+", e.updates(Side::right, true)}, {"-", e.updates(Side::right, false)}};
+          rep.left.updates = {{"+", e.updates(Side::left, true)}, {"-", e.updates(Side::left, false)}};
+        } else {
+          rep.has_c = true;
+          rep.right.updates = {{"all", e.updates(Side::right)}};
+          rep.left.updates = {{"all", e.updates(Side::left)}};
+          if constexpr (std::is_same_v<E, CoupledCartsEstimator>) {
+            rep.has_shared_d = true;
+            rep.d = e.deadband();
+            rep.d_updates = {{"+", e.deadband_updates(true)}, {"-", e.deadband_updates(false)}};
+          }
+        }
+      },
+      e_);
+  return rep;
+}
+
+EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> v, std::span<const double> y,
+                            bool keep_trace) {
+  if (v.size() != y.size()) throw std::invalid_argument("v and y differ in length");
+  AnyEstimator est(cfg);
+  EstimationRun run;
+  const std::size_t n = v.size();
+  run.yhat.resize(n);
+  run.ysim.resize(n);
+  run.param_names = est.param_names();
+  std::vector<double> pv(run.param_names.size());
+  if (keep_trace) run.params.assign(pv.size(), std::vector<double>(n));
+  for (std::size_t k = 0; k < n; ++k) {
+    run.yhat[k] = est.step(v[k], y[k]);
+    run.ysim[k] = est.simulated();
+    if (keep_trace) {
+      est.param_values(pv);
+      for (std::size_t p = 0; p < pv.size(); ++p) run.params[p][k] = pv[p];
+    }
+  }
+  run.report = est.report();
+  return run;
+}
+
+double nrmse(std::span<const double> t, std::span<const double> y, std::span<const double> ysim, double t0_s,
+             double t1_s) {
+  double se = 0.0, ymax = 0.0;
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    if (t[k] < t0_s || t[k] > t1_s) continue;
+    const double e = y[k] - ysim[k];
+    se += e * e;
+    ymax = std::max(ymax, std::fabs(y[k]));
+    ++n;
+  }
+  if (n == 0 || ymax == 0.0) return std::numeric_limits<double>::quiet_NaN();
+  return std::sqrt(se / static_cast<double>(n)) / ymax;
+}
+
+double outside_3sigma_per_1000(std::span<const double> t, std::span<const double> y, std::span<const double> yhat,
+                               double sigma, double t0_s, double t1_s) {
+  std::size_t n = 0, out = 0;
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    if (t[k] < t0_s || t[k] > t1_s) continue;
+    ++n;
+    if (!(std::fabs(y[k] - yhat[k]) <= 3.0 * sigma)) ++out;
+  }
+  return n == 0 ? std::numeric_limits<double>::quiet_NaN() : 1000.0 * static_cast<double>(out) / static_cast<double>(n);
+}
+
+}  // namespace lash

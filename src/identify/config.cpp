@@ -1,0 +1,115 @@
+#include "lash/identify/config.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace lash {
+
+ModelKind parse_model_kind(std::string_view n) {
+  if (n == "linear") return ModelKind::linear;
+  if (n == "input-deadzone") return ModelKind::input_deadzone;
+  if (n == "output-deadzone") return ModelKind::output_deadzone;
+  if (n == "deadzone-deadband") return ModelKind::deadzone_deadband;
+  if (n == "coupled-carts") return ModelKind::coupled_carts;
+  throw std::invalid_argument("unknown model '" + std::string(n) +
+                              "' (linear, input-deadzone, output-deadzone, deadzone-deadband, coupled-carts)");
+}
+
+const char* to_string(ModelKind m) noexcept {
+  switch (m) {
+    case ModelKind::linear: return "linear";
+    case ModelKind::input_deadzone: return "input-deadzone";
+    case ModelKind::output_deadzone: return "output-deadzone";
+    case ModelKind::deadzone_deadband: return "deadzone-deadband";
+    case ModelKind::coupled_carts: return "coupled-carts";
+  }
+  return "?";
+}
+
+EstimationMethod parse_method(std::string_view n) {
+  if (n == "ls" || n == "rls") return EstimationMethod::ls;
+  if (n == "iv") return EstimationMethod::iv;
+  throw std::invalid_argument("unknown method '" + std::string(n) + "' (ls, iv)");
+}
+
+const char* to_string(EstimationMethod m) noexcept { return m == EstimationMethod::iv ? "iv" : "ls"; }
+
+namespace {
+void require(bool ok, const char* field, const std::string& msg) {
+  if (!ok) throw std::invalid_argument(std::string(field) + ": " + msg);
+}
+}  // namespace
+
+void EstimatorConfig::validate() const {
+  require(std::isfinite(dt_s) && dt_s > 0, "dt", "sample period must be > 0 [s]");
+  require(!std::isnan(guess_left) && !std::isnan(guess_right), "guess", "guesses must be numbers");
+  const bool needs_guesses = model == ModelKind::input_deadzone || model == ModelKind::deadzone_deadband;
+  if (needs_guesses) {
+    require(std::isfinite(guess_left) && std::isfinite(guess_right), "guess-left/guess-right",
+            "this model needs both deadzone guesses c_l* and c_r*");
+    require(guess_left < guess_right, "guess-left",
+            "guess-left must be < guess-right (the guesses lie outside the deadzone: c_l* < c_l <= c_r < c_r*)");
+  }
+  require(rls.lambda > 0 && rls.lambda <= 1, "lambda", "forgetting factor must be in (0, 1]");
+  require(std::isfinite(rls.p0) && rls.p0 > 0, "p0", "initial covariance must be > 0");
+  require(rls.trace_max > 0, "trace-max", "must be > 0");
+  for (std::size_t i = 0; i < 3; ++i) {
+    require(std::isfinite(rls.eta0[i]), "eta0", "must be finite");
+    require(!std::isnan(rls.lower[i]) && !std::isnan(rls.upper[i]) && rls.lower[i] <= rls.upper[i], "bounds",
+            "need lower <= upper");
+  }
+  require(noise.filter_length >= 1 && noise.filter_length <= 100000, "filter-length", "must be in 1..100000");
+  require(noise.derivative_filter_length >= 1 && noise.derivative_filter_length <= 100000,
+          "derivative-filter-length", "must be in 1..100000");
+  require(noise.input_delay <= 100000, "input-delay", "must be <= 100000 samples");
+  require(noise.align_delay <= 100000, "align-delay", "must be <= 100000 samples");
+  require(std::isfinite(noise.derivative_threshold) && noise.derivative_threshold >= 0, "derivative-threshold",
+          "must be >= 0 [y unit/s]");
+  require(iv_delay >= 1 && iv_delay <= 60, "iv-delay", "must be in 1..60 samples");
+  require(min_updates >= 1, "min-updates", "must be >= 1");
+  require(std::isfinite(singular_tol) && singular_tol > 0, "singular-tol", "must be > 0");
+  require(std::isfinite(zero_threshold) && zero_threshold >= 0, "zero-threshold", "must be >= 0");
+  require(accel_limit > 0, "accel-limit", "must be > 0");
+  require(std::isfinite(stage2_start_s) && stage2_start_s >= 0, "stage2-start", "must be >= 0 [s]");
+  if (method == EstimationMethod::iv)
+    require(rls.forgetting == Forgetting::exponential, "forgetting", "iv supports exponential forgetting only");
+}
+
+RlsConfig<3> EstimatorConfig::rls3() const {
+  RlsConfig<3> c;
+  c.lambda = rls.lambda;
+  c.p0 = rls.p0;
+  c.eta0 = rls.eta0;
+  c.forgetting = rls.forgetting;
+  c.trace_max = rls.trace_max;
+  c.lower = rls.lower;
+  c.upper = rls.upper;
+  return c;
+}
+
+RlsConfig<2> EstimatorConfig::rls2() const {
+  RlsConfig<2> c;
+  c.lambda = rls.lambda;
+  c.p0 = rls.p0;
+  c.eta0 = {rls.eta0[0], rls.eta0[1]};
+  c.forgetting = rls.forgetting;
+  c.trace_max = rls.trace_max;
+  c.lower = {rls.lower[0], rls.lower[1]};
+  c.upper = {rls.upper[0], rls.upper[1]};
+  return c;
+}
+
+RlsConfig<4> EstimatorConfig::rls4() const {
+  RlsConfig<4> c;
+  c.lambda = rls.lambda;
+  c.p0 = rls.p0;
+  c.eta0 = {rls.eta0[0], rls.eta0[1], rls.eta0[2], 0.0};
+  c.forgetting = rls.forgetting;
+  c.trace_max = rls.trace_max;
+  c.lower = {rls.lower[0], rls.lower[1], rls.lower[2], -std::numeric_limits<double>::infinity()};
+  c.upper = {rls.upper[0], rls.upper[1], rls.upper[2], std::numeric_limits<double>::infinity()};
+  return c;
+}
+
+}  // namespace lash

@@ -1,0 +1,352 @@
+#include "lash/identify/estimators.hpp"
+
+#include <cmath>
+
+namespace lash {
+
+using detail::kNaN;
+
+namespace {
+const EstimatorConfig& checked(const EstimatorConfig& c) {
+  c.validate();
+  return c;
+}
+bool finite_all(double a, double b) noexcept { return std::isfinite(a) && std::isfinite(b); }
+}  // namespace
+
+// ---------------------------------------------------------------- linear (eq. 9–16)
+
+LinearEstimator::LinearEstimator(const EstimatorConfig& cfg)
+    : cfg_(checked(cfg)), pre_(cfg.noise, cfg.dt_s), rls_(cfg.rls2()) {}
+
+double LinearEstimator::step(double v, double y) noexcept {
+  if (!finite_all(v, y)) {
+    ++skipped_;
+    return yhat_ = kNaN;
+  }
+  const Conditioned s = pre_.step(v, y);
+  const std::array<double, 2> phi{-y1_, v1_};
+  if (cfg_.method == EstimationMethod::iv)
+    yhat_ = rls_.update_iv(phi, {-hist_.ago(1 + cfg_.iv_delay), v1_}, s.y);
+  else
+    yhat_ = rls_.update(phi, s.y);
+  hist_.push(s.y);
+  y1_ = s.y;
+  v1_ = s.v;
+  x_ = -rls_.eta(0) * x_ + rls_.eta(1) * vraw1_;
+  ysim_ = x_;
+  vraw1_ = v;
+  return yhat_;
+}
+
+SideParams LinearEstimator::params() const noexcept {
+  SideParams p;
+  p.identified = identified();
+  if (p.identified) {
+    p.a1 = rls_.eta(0);
+    p.b1 = rls_.eta(1);
+  }
+  return p;
+}
+
+// ---------------------------------------------------------------- input deadzone (§1.4.2)
+
+InputDeadzoneEstimator::InputDeadzoneEstimator(const EstimatorConfig& cfg)
+    : cfg_(checked(cfg)), pre_(cfg.noise, cfg.dt_s), rls_{Rls<3>(cfg.rls3()), Rls<3>(cfg.rls3())} {
+  sc_ = {cfg.guess_right, cfg.guess_left};
+}
+
+std::uint64_t InputDeadzoneEstimator::skipped() const noexcept {
+  return skipped_ + rls_[0].skipped() + rls_[1].skipped();
+}
+
+void InputDeadzoneEstimator::refresh(int i) noexcept {
+  const auto& e = rls_[i].eta();
+  SideParams& p = p_[i];
+  sa1_[i] = e[0];
+  sb1_[i] = e[1];
+  const bool ok = rls_[i].updates() >= cfg_.min_updates && std::fabs(e[1]) > 1e-12;
+  const double c = ok ? -e[2] / e[1] : kNaN;  // e = −b1·c (eq. 21–22)
+  p.identified = ok && std::isfinite(c);
+  if (p.identified) {
+    p.a1 = e[0];
+    p.b1 = e[1];
+    p.c = c;
+    sc_[i] = c;
+  } else {
+    p = SideParams{};
+  }
+}
+
+double InputDeadzoneEstimator::step(double v, double y) noexcept {
+  if (!finite_all(v, y)) {
+    ++skipped_;
+    return yhat_ = kNaN;
+  }
+  const Conditioned s = pre_.step(v, y);
+  const double y1 = y1_, v1 = v1_;
+  const int side = v1 > cfg_.guess_right ? 0 : (v1 < cfg_.guess_left ? 1 : -1);
+  if (side >= 0) {
+    const std::array<double, 3> phi{-y1, v1, 1.0};
+    if (cfg_.method == EstimationMethod::iv)
+      yhat_ = rls_[side].update_iv(phi, {-hist_.ago(1 + cfg_.iv_delay), v1, 1.0}, s.y);
+    else
+      yhat_ = rls_[side].update(phi, s.y);
+    refresh(side);
+    last_ = side;
+  } else {
+    yhat_ = -rls_[last_].eta(0) * y1;  // inside the deadzone u = 0 (eq. 17), a1 of the side last used
+  }
+  hist_.push(s.y);
+  y1_ = s.y;
+  v1_ = s.v;
+  // free-run simulation of eq. 17 driven by the raw v
+  int ss;
+  if (cfg_.sim_side_by_sign) ss = vraw1_ >= 0.0 ? 0 : 1;
+  else ss = vraw1_ > sc_[0] ? 0 : (vraw1_ < sc_[1] ? 1 : sim_last_);
+  sim_last_ = ss;
+  w_ = -sa1_[ss] * w_ + sb1_[ss] * detail::deadzone(vraw1_, sc_[1], sc_[0]);
+  ysim_ = w_;
+  vraw1_ = v;
+  return yhat_;
+}
+
+// ---------------------------------------------------------------- output deadzone (§1.6.1)
+
+OutputDeadzoneEstimator::OutputDeadzoneEstimator(const EstimatorConfig& cfg)
+    : cfg_(checked(cfg)), pre_(cfg.noise, cfg.dt_s), rls_{Rls<3>(cfg.rls3()), Rls<3>(cfg.rls3())} {}
+
+std::uint64_t OutputDeadzoneEstimator::skipped() const noexcept {
+  return skipped_ + rls_[0].skipped() + rls_[1].skipped();
+}
+
+void OutputDeadzoneEstimator::refresh(int i) noexcept {
+  const auto& e = rls_[i].eta();
+  SideParams& p = p_[i];
+  sa1_[i] = e[0];
+  sb1_[i] = e[1];
+  const double den = 1.0 + e[0];
+  const bool ok = rls_[i].updates() >= cfg_.min_updates && std::fabs(den) > 1e-9;
+  const double c = ok ? -e[2] / den : kNaN;  // e = −c(1 + a1) (eq. 36)
+  p.identified = ok && std::isfinite(c);
+  if (p.identified) {
+    p.a1 = e[0];
+    p.b1 = e[1];
+    p.c = c;
+    sc_[i] = c;
+  } else {
+    p = SideParams{};
+  }
+}
+
+double OutputDeadzoneEstimator::step(double v, double y) noexcept {
+  if (!finite_all(v, y)) {
+    ++skipped_;
+    return yhat_ = kNaN;
+  }
+  const Conditioned s = pre_.step(v, y);
+  const double y1 = y1_, v1 = v1_, z = cfg_.zero_threshold;
+  const int side = (s.y > z && y1 > z) ? 0 : ((s.y < -z && y1 < -z) ? 1 : -1);
+  // free-run simulation: x = G(v), y_sim = DZ(x); the side follows x against the deadzone
+  {
+    const int ss = x_ > sc_[0] ? 0 : (x_ < sc_[1] ? 1 : sim_last_);
+    sim_last_ = ss;
+    x_ = -sa1_[ss] * x_ + sb1_[ss] * vraw1_;
+    ysim_ = detail::deadzone(x_, sc_[1], sc_[0]);
+    vraw1_ = v;
+  }
+  if (side >= 0) {
+    const std::array<double, 3> phi{-y1, v1, 1.0};
+    if (cfg_.method == EstimationMethod::iv)
+      yhat_ = rls_[side].update_iv(phi, {-hist_.ago(1 + cfg_.iv_delay), v1, 1.0}, s.y);
+    else
+      yhat_ = rls_[side].update(phi, s.y);
+    refresh(side);
+  } else {
+    const int ps = y1 > z ? 0 : (y1 < -z ? 1 : -1);
+    yhat_ = ps >= 0 ? rls_[ps].predict({-y1, v1, 1.0}) : 0.0;
+    if (ps == 0 && yhat_ < 0.0) yhat_ = 0.0;
+    if (ps == 1 && yhat_ > 0.0) yhat_ = 0.0;
+  }
+  hist_.push(s.y);
+  y1_ = s.y;
+  v1_ = s.v;
+  return yhat_;
+}
+
+// ---------------------------------------------------------------- deadzone + deadband (§1.4.3)
+
+DeadzoneDeadbandEstimator::DeadzoneDeadbandEstimator(const EstimatorConfig& cfg)
+    : cfg_(checked(cfg)),
+      pre_(cfg.noise, cfg.dt_s),
+      rls_{Rls<3>(cfg.rls3()), Rls<3>(cfg.rls3()), Rls<3>(cfg.rls3()), Rls<3>(cfg.rls3())},
+      pooled_{Rls<4>(cfg.rls4()), Rls<4>(cfg.rls4())} {
+  sc_ = {cfg.guess_right, cfg.guess_left};
+}
+
+std::uint64_t DeadzoneDeadbandEstimator::skipped() const noexcept {
+  std::uint64_t n = skipped_;
+  for (const auto& r : rls_) n += r.skipped();
+  for (const auto& r : pooled_) n += r.skipped();
+  return n;
+}
+
+void DeadzoneDeadbandEstimator::refresh(int side) noexcept {
+  SideParams& p = p_[side];
+  const std::uint64_t np = count_[side * 2], nm = count_[side * 2 + 1];
+  double a1, b1, c, d;
+  bool ok = np >= cfg_.min_updates && nm >= cfg_.min_updates;
+  if (cfg_.pooled) {
+    // η = [a1, b1, e0, g] with e± = e0 ∓ g, e0 = −b1·c, g = d(1 + a1)
+    const auto& e = pooled_[side].eta();
+    a1 = e[0];
+    b1 = e[1];
+    const double den = 1.0 + a1;
+    ok = ok && std::fabs(den) > cfg_.singular_tol && std::fabs(b1) > 1e-12;
+    c = -e[2] / b1;
+    d = e[3] / den;
+  } else {
+    const auto& ep = rls_[side * 2].eta();
+    const auto& em = rls_[side * 2 + 1].eta();
+    const double n = static_cast<double>(np + nm);
+    const double wp = n > 0 ? static_cast<double>(np) / n : 0.5;
+    a1 = wp * ep[0] + (1.0 - wp) * em[0];
+    b1 = wp * ep[1] + (1.0 - wp) * em[1];
+    // eq. 31/32: [−(1+a+)  −b+; (1+a−)  −b−] [d; c] = [e+; e−]
+    const double t1 = (1.0 + ep[0]) * em[1], t2 = ep[1] * (1.0 + em[0]);
+    const double det = t1 + t2;
+    ok = ok && std::fabs(det) > cfg_.singular_tol * (std::fabs(t1) + std::fabs(t2));
+    const double inv = 1.0 / det;
+    d = (-em[1] * ep[2] + ep[1] * em[2]) * inv;
+    c = (-(1.0 + em[0]) * ep[2] - (1.0 + ep[0]) * em[2]) * inv;
+  }
+  ok = ok && std::isfinite(c) && std::isfinite(d) && std::isfinite(a1) && std::isfinite(b1);
+  sa1_[side] = a1;
+  sb1_[side] = b1;
+  if (ok) {
+    p.a1 = a1;
+    p.b1 = b1;
+    p.c = c;
+    p.d = d;
+    p.identified = true;
+    sc_[side] = c;
+    sd_[side] = d > 0.0 ? d : 0.0;
+  } else {
+    p = SideParams{};
+  }
+}
+
+double DeadzoneDeadbandEstimator::predict_free(int side, double y1, double v1) const noexcept {
+  // Deadband logic in the y domain: moving up if the + model lands above y(k−1), down if the
+  // − model lands below it, otherwise the output holds.
+  double up, down;
+  if (cfg_.pooled) {
+    up = pooled_[side].predict({-y1, v1, 1.0, -1.0});
+    down = pooled_[side].predict({-y1, v1, 1.0, 1.0});
+  } else {
+    up = rls_[side * 2].predict({-y1, v1, 1.0});
+    down = rls_[side * 2 + 1].predict({-y1, v1, 1.0});
+  }
+  if (up > y1) return up;
+  if (down < y1) return down;
+  return y1;
+}
+
+// ---------------------------------------------------------------- coupled carts (§1.6.3)
+
+CoupledCartsEstimator::CoupledCartsEstimator(const EstimatorConfig& cfg)
+    : cfg_(checked(cfg)),
+      pre_(cfg.noise, cfg.dt_s),
+      rls_{Rls<3>(cfg.rls3()), Rls<3>(cfg.rls3())},
+      drls_([&] {
+        RlsConfig<2> c;
+        c.lambda = 1.0;
+        c.p0 = cfg.rls.p0;
+        return c;
+      }()) {
+  stage2_k_ = static_cast<std::uint64_t>(std::ceil(cfg.stage2_start_s / cfg.dt_s - 1e-9));
+}
+
+std::uint64_t CoupledCartsEstimator::skipped() const noexcept {
+  return skipped_ + rls_[0].skipped() + rls_[1].skipped() + drls_.skipped();
+}
+
+void CoupledCartsEstimator::refresh(int i) noexcept {
+  const auto& e = rls_[i].eta();
+  SideParams& p = p_[i];
+  sa1_[i] = e[0];
+  sb1_[i] = e[1];
+  const double den = 1.0 + e[0];
+  const bool ok = rls_[i].updates() >= cfg_.min_updates && std::fabs(den) > 1e-9;
+  const double c = ok ? -e[2] / den : kNaN;  // eq. 38: e = −c(1 + a1)
+  p.identified = ok && std::isfinite(c);
+  if (p.identified) {
+    p.a1 = e[0];
+    p.b1 = e[1];
+    p.c = c;
+    sc_[i] = c;
+  } else {
+    p = SideParams{};
+  }
+}
+
+SideParams CoupledCartsEstimator::params(Side s) const noexcept {
+  SideParams p = p_[detail::side_index(s)];
+  p.d = deadband();
+  return p;
+}
+
+double CoupledCartsEstimator::deadband() const noexcept {
+  return dcount_[0] + dcount_[1] >= cfg_.min_updates && dcount_[0] > 0 && dcount_[1] > 0 ? drls_.eta(1) : kNaN;
+}
+
+bool CoupledCartsEstimator::identified() const noexcept {
+  return p_[0].identified && p_[1].identified && std::isfinite(deadband());
+}
+
+double CoupledCartsEstimator::step(double v, double y) noexcept {
+  if (!finite_all(v, y)) {
+    ++skipped_;
+    return yhat_ = kNaN;
+  }
+  const Conditioned s = pre_.step(v, y);
+  const double vel = s.ydot;  // free-cart velocity
+  const int dir = direction(vel, cfg_.noise.derivative_threshold);
+  const double vel1 = vel1_, v1 = v1_;
+  const bool steady = std::fabs(vel - vel1) * (1.0 / cfg_.dt_s) <= cfg_.accel_limit;
+  double vel_pred = 0.0;
+  if (dir != 0 && dir == dir1_ && dir == dir2_ && steady) {
+    const int i = dir > 0 ? 0 : 1;
+    vel_pred = rls_[i].update({-vel1, v1, 1.0}, vel);
+    refresh(i);
+  } else if (dir1_ != 0) {
+    vel_pred = rls_[dir1_ > 0 ? 0 : 1].predict({-vel1, v1, 1.0});
+  }
+  yhat_ = y1_ + cfg_.dt_s * vel_pred;
+  // free-run: velocity model (output deadzone) → integrate (eq. 39–40) → deadband (eq. 41)
+  const int ss = x_ > sc_[0] ? 0 : (x_ < sc_[1] ? 1 : sim_last_);
+  sim_last_ = ss;
+  x_ = -sa1_[ss] * x_ + sb1_[ss] * vraw1_;
+  wdot_ = detail::deadzone(x_, sc_[1], sc_[0]);
+  w_ += cfg_.dt_s * wdot_;
+  vraw1_ = v;
+  // stage 2: y − ŵ = o − d moving +, o + d moving − (lash deadband: y = w ∓ d while engaged)
+  if (k_ >= stage2_k_ && dir != 0) {
+    drls_.update({1.0, dir > 0 ? -1.0 : 1.0}, s.y - w_);
+    ++dcount_[dir > 0 ? 0 : 1];
+  }
+  const double dd = std::isfinite(deadband()) && drls_.eta(1) > 0 ? drls_.eta(1) : 0.0;
+  const double wp = w_ + drls_.eta(0);
+  if (wp < ydb_ - dd) ydb_ = wp + dd;
+  else if (wp > ydb_ + dd) ydb_ = wp - dd;
+  ysim_ = ydb_;
+  y1_ = s.y;
+  v1_ = s.v;
+  vel1_ = vel;
+  dir2_ = dir1_;
+  dir1_ = dir;
+  ++k_;
+  return yhat_;
+}
+
+}  // namespace lash

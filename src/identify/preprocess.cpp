@@ -1,0 +1,36 @@
+#include "lash/identify/preprocess.hpp"
+
+namespace lash {
+
+Preprocessor::Preprocessor(const NoiseSettings& s, double dt_s)
+    : identity_(s.filter_length == 1 && !s.filter_input && s.input_delay == 0 && s.derivative_filter_length == 1 &&
+                s.align_delay == 0),
+      filter_y_(s.filter_length > 1),
+      filter_v_(s.filter_input && s.filter_length > 1),
+      filter_d_(s.derivative_filter_length > 1),
+      inv_dt_(1.0 / dt_s),
+      s_(s),
+      ma_y_(s.filter_length),
+      ma_v_(s.filter_length),
+      ma_d_(s.derivative_filter_length),
+      diff_(dt_s),
+      delay_v_(s.input_delay),
+      align_v_(s.align_delay),
+      align_y_(s.align_delay) {}
+
+void Preprocessor::reset() noexcept {
+  y_prev_ = 0.0;
+  ma_y_.reset();
+  ma_v_.reset();
+  ma_d_.reset();
+  diff_.reset();
+  delay_v_.reset();
+  align_v_.reset();
+  align_y_.reset();
+}
+
+double Preprocessor::output_delay_samples() const noexcept {
+  return (filter_y_ ? ma_y_.delay_samples() : 0.0) + static_cast<double>(s_.align_delay);
+}
+
+}  // namespace lash

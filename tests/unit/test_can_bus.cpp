@@ -1,0 +1,154 @@
+// In-memory bus and the python-can udp_multicast datagram format.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "lash/can/bus.hpp"
+#include "lash/can/datagram.hpp"
+#include "lash/io/error.hpp"
+#include "lash/signals/rng.hpp"
+
+using namespace lash::can;
+using namespace std::chrono_literals;
+
+namespace {
+std::vector<std::uint8_t> unhex(const std::string& h) {
+  std::vector<std::uint8_t> v;
+  for (std::size_t i = 0; i + 1 < h.size(); i += 2) v.push_back(static_cast<std::uint8_t>(std::stoi(h.substr(i, 2), nullptr, 16)));
+  return v;
+}
+// Bytes produced by python-can 4.1 (can.interfaces.udp_multicast.utils.pack_message) for
+// Message(timestamp=1.5, arbitration_id=0x123, data=DEADBEEF) and
+// Message(timestamp=0, arbitration_id=0x1abcdef0, is_extended_id=True, is_remote_frame=True, dlc=3).
+const char* kPy1 =
+    "8ba974696d657374616d70cb3ff8000000000000ae6172626974726174696f6e5f6964cd0123ae69735f657874656e6465645f6964c2af6973"
+    "5f72656d6f74655f6672616d65c2ae69735f6572726f725f6672616d65c2a76368616e6e656cc0a3646c6304a464617461c404deadbeefa569"
+    "735f6664c2ae626974726174655f737769746368c2b56572726f725f73746174655f696e64696361746f72c2";
+const char* kPy2 =
+    "8ba974696d657374616d70cb0000000000000000ae6172626974726174696f6e5f6964ce1abcdef0ae69735f657874656e6465645f6964c3af"
+    "69735f72656d6f74655f6672616d65c3ae69735f6572726f725f6672616d65c2a76368616e6e656cc0a3646c6303a464617461c400a56973"
+    "5f6664c2ae626974726174655f737769746368c2b56572726f725f73746174655f696e64696361746f72c2";
+}  // namespace
+
+TEST(CanBus, MemBusDeliversToOthersInOrderNotToSelf) {
+  auto a = open_bus("mem:t1");
+  auto b = open_bus("mem:t1");
+  auto c = open_bus("mem:t1");
+  auto other = open_bus("mem:t2");
+  for (std::uint32_t i = 0; i < 10; ++i) {
+    Frame f;
+    f.id = i;
+    f.len = 1;
+    f.data[0] = static_cast<std::uint8_t>(i * 3);
+    f.timestamp_s = 0.005 * i;
+    ASSERT_TRUE(a->send(f));
+  }
+  EXPECT_FALSE(a->receive(0ns).has_value());
+  EXPECT_FALSE(other->receive(0ns).has_value());
+  for (std::uint32_t i = 0; i < 10; ++i) {
+    auto fb = b->receive(0ns);
+    auto fc = c->receive(1ms);
+    ASSERT_TRUE(fb && fc);
+    EXPECT_EQ(fb->id, i);
+    EXPECT_EQ(fc->data[0], i * 3);
+    EXPECT_EQ(fb->timestamp_s, 0.005 * i);
+  }
+  EXPECT_EQ(a->stats().sent, 10u);
+  EXPECT_EQ(b->stats().received, 10u);
+  EXPECT_EQ(b->address(), "mem:t1");
+}
+
+TEST(CanBus, Filters) {
+  auto a = open_bus("mem:f");
+  auto b = open_bus("mem:f");
+  b->set_filters({{0x100, 0x700, false}, {0x18FF0000, 0x1FFF0000, true}});
+  Frame f;
+  for (std::uint32_t id : {0x100u, 0x1FFu, 0x200u}) {
+    f.id = id;
+    a->send(f);
+  }
+  f.extended = true;
+  f.id = 0x18FF1234;
+  a->send(f);
+  f.id = 0x100;  // extended 0x100 does not match the standard filter
+  a->send(f);
+  std::vector<std::uint32_t> got;
+  while (auto r = b->receive(0ns)) got.push_back(r->id);
+  EXPECT_EQ(got, (std::vector<std::uint32_t>{0x100, 0x1FF, 0x18FF1234}));
+  EXPECT_EQ(b->stats().filtered, 2u);
+}
+
+TEST(CanBus, BadAddresses) {
+  EXPECT_THROW(open_bus("nope:x"), lash::InputError);
+  EXPECT_THROW(open_bus("mem:"), lash::InputError);
+  EXPECT_THROW(open_bus("udp:10.0.0.1:43113"), lash::InputError);
+  EXPECT_THROW(open_bus("udp:239.74.163.2:99999"), lash::InputError);
+  EXPECT_THROW(open_bus("udp:239.74.163.2:43113,foo=1"), lash::InputError);
+  EXPECT_THROW(open_bus("socketcan:lash_no_such_if0"), lash::InputError);
+}
+
+TEST(CanDatagram, EncodesExactlyLikePythonCan) {
+  Frame f;
+  f.id = 0x123;
+  f.len = 4;
+  f.data = {0xDE, 0xAD, 0xBE, 0xEF};
+  std::uint8_t buf[256];
+  std::size_t n = udp::encode_datagram(f, 1.5, buf);
+  EXPECT_EQ(std::vector<std::uint8_t>(buf, buf + n), unhex(kPy1));
+  Frame r;
+  r.id = 0x1abcdef0;
+  r.extended = true;
+  r.remote = true;
+  r.len = 3;
+  n = udp::encode_datagram(r, 0.0, buf);
+  EXPECT_EQ(std::vector<std::uint8_t>(buf, buf + n), unhex(kPy2));
+}
+
+TEST(CanDatagram, DecodesPythonCanBytes) {
+  Frame f;
+  ASSERT_EQ(udp::decode_datagram(unhex(kPy1), f), udp::DecodeStatus::ok);
+  EXPECT_EQ(f.id, 0x123u);
+  EXPECT_EQ(f.len, 4);
+  EXPECT_EQ(f.data[3], 0xEF);
+  EXPECT_EQ(f.timestamp_s, 1.5);
+  ASSERT_EQ(udp::decode_datagram(unhex(kPy2), f), udp::DecodeStatus::ok);
+  EXPECT_TRUE(f.extended && f.remote);
+  EXPECT_EQ(f.len, 3);
+}
+
+TEST(CanDatagram, RejectsBadDatagrams) {
+  Frame f;
+  auto ok = unhex(kPy1);
+  // unknown key: rename "channel" to "chunnel"
+  auto u = ok;
+  const std::string ch = "channel";
+  auto it = std::search(u.begin(), u.end(), ch.begin(), ch.end());
+  ASSERT_NE(it, u.end());
+  it[2] = 'u';
+  EXPECT_EQ(udp::decode_datagram(u, f), udp::DecodeStatus::unknown_key);
+  // truncated
+  EXPECT_EQ(udp::decode_datagram(std::span(ok.data(), ok.size() - 1), f), udp::DecodeStatus::malformed);
+  // trailing garbage
+  auto t = ok;
+  t.push_back(0);
+  EXPECT_EQ(udp::decode_datagram(t, f), udp::DecodeStatus::malformed);
+  // oversized
+  std::vector<std::uint8_t> big(udp::kMaxDatagram + 1, 0x90);
+  EXPECT_EQ(udp::decode_datagram(big, f), udp::DecodeStatus::oversized);
+  // dlc 5 with 4 data bytes
+  auto d = ok;
+  const std::string dlc = "dlc";
+  it = std::search(d.begin(), d.end(), dlc.begin(), dlc.end());
+  it[3] = 5;
+  EXPECT_EQ(udp::decode_datagram(d, f), udp::DecodeStatus::invalid);
+  // random bytes never crash
+  lash::Rng rng(3);
+  int okc = 0;
+  for (int i = 0; i < 20000; ++i) {
+    auto m = ok;
+    for (int k = 0; k < 3; ++k) m[rng.next() % m.size()] = static_cast<std::uint8_t>(rng.next());
+    if (udp::decode_datagram(m, f) == udp::DecodeStatus::ok) ++okc;
+  }
+  EXPECT_GT(okc, 0);
+}

@@ -1,0 +1,445 @@
+// Identification (SPEC A3–A5): RLS, the switching estimators, E1.
+// Reference numbers come from the plant parameters that generated the data (the estimator
+// never sees them) and from hand-checked identities; statsmodels agreement is a script test.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "lash/blocks.hpp"
+#include "lash/identify/any_estimator.hpp"
+#include "lash/identify/rls.hpp"
+#include "lash/plant/plant.hpp"
+#include "lash/plant/plant_file.hpp"
+#include "lash/plant/simulate.hpp"
+#include "lash/signals/rng.hpp"
+
+namespace lash {
+namespace {
+
+double rel_err(double est, double truth) { return std::fabs(est - truth) / std::fabs(truth); }
+
+// ------------------------------------------------------------------------------------------ Rls
+
+TEST(Rls, RecoversExactRegressionAndKeepsPSymmetric) {
+  // y = 2 x1 − 3 x2 + 0.5, noise-free, random regressors: LS is exact after N ≥ 3 samples.
+  RlsConfig<3> c;
+  c.lambda = 0.98;
+  c.p0 = 1e6;
+  Rls<3> r(c);
+  Rng rng(7);
+  for (int k = 0; k < 200; ++k) {
+    const double x1 = rng.gaussian(), x2 = rng.gaussian();
+    r.update({x1, x2, 1.0}, 2 * x1 - 3 * x2 + 0.5);
+  }
+  // the only deviation from exact LS is the prior P0⁻¹ forgotten by λ^200 (≈ 2e-8 relative)
+  EXPECT_NEAR(r.eta(0), 2.0, 1e-7);
+  EXPECT_NEAR(r.eta(1), -3.0, 1e-7);
+  EXPECT_NEAR(r.eta(2), 0.5, 1e-7);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) EXPECT_EQ(r.P()[i][j], r.P()[j][i]);
+  EXPECT_EQ(r.updates(), 200u);
+}
+
+TEST(Rls, FirstStepMatchesHandComputation) {
+  // P0 = 10 I, λ = 0.5, η0 = 0, φ = [1, 2], y = 3:
+  // Pφ = [10, 20], φᵀPφ = 50, q = [10, 20]/50.5, η = q·3, P = (P − qφᵀP)/λ.
+  RlsConfig<2> c;
+  c.lambda = 0.5;
+  c.p0 = 10.0;
+  Rls<2> r(c);
+  const double yhat = r.update({1.0, 2.0}, 3.0);
+  EXPECT_EQ(yhat, 0.0);
+  EXPECT_NEAR(r.eta(0), 30.0 / 50.5, 1e-15);
+  EXPECT_NEAR(r.eta(1), 60.0 / 50.5, 1e-15);
+  EXPECT_NEAR(r.P()[0][0], (10.0 - 100.0 / 50.5) / 0.5, 1e-12);
+  EXPECT_NEAR(r.P()[0][1], (0.0 - 200.0 / 50.5) / 0.5, 1e-12);
+  EXPECT_NEAR(r.P()[1][1], (10.0 - 400.0 / 50.5) / 0.5, 1e-12);
+}
+
+TEST(Rls, NonFiniteSampleIsSkippedAndCounted) {
+  Rls<3> r(RlsConfig<3>{});
+  r.update({1.0, 2.0, 1.0}, 4.0);
+  const auto eta = r.eta();
+  const auto P = r.P();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_TRUE(std::isnan(r.update({nan, 1.0, 1.0}, 1.0)));
+  r.update({1.0, 1.0, 1.0}, std::numeric_limits<double>::infinity());
+  EXPECT_EQ(r.skipped(), 2u);
+  EXPECT_EQ(r.updates(), 1u);
+  EXPECT_EQ(r.eta(), eta);
+  EXPECT_EQ(r.P(), P);
+}
+
+TEST(Rls, BoundsProjectTheEstimate) {
+  RlsConfig<2> c;
+  c.lower = {-1.0, 0.0001};
+  c.upper = {0.0, 2.0};
+  c.eta0 = {0.5, 5.0};  // projected at reset
+  Rls<2> r(c);
+  EXPECT_EQ(r.eta(0), 0.0);
+  EXPECT_EQ(r.eta(1), 2.0);
+  for (int k = 0; k < 50; ++k) r.update({1.0, static_cast<double>(k % 3)}, 10.0 + 7.0 * (k % 3));  // wants b1 = 7
+  EXPECT_LE(r.eta(1), 2.0);
+  EXPECT_GE(r.eta(0), -1.0);
+  EXPECT_LE(r.eta(0), 0.0);
+}
+
+TEST(Rls, InvalidConfigThrows) {
+  RlsConfig<2> c;
+  c.lambda = 1.5;
+  EXPECT_THROW(Rls<2>{c}, std::invalid_argument);
+  c.lambda = 0.99;
+  c.p0 = -1;
+  EXPECT_THROW(Rls<2>{c}, std::invalid_argument);
+}
+
+// Zero excitation for 10⁶ samples: P stays finite and bounded, the estimate does not move.
+void zero_excitation(Forgetting f, bool constant_phi) {
+  RlsConfig<3> c;
+  c.lambda = 0.99;
+  c.p0 = 1000.0;
+  c.forgetting = f;
+  c.trace_max = 1e8;
+  Rls<3> r(c);
+  // learn y = −0.96·y1 + 0.1·v + 5 first
+  Rng rng(3);
+  for (int k = 0; k < 500; ++k) {
+    const double a = rng.gaussian() * 100, b = rng.gaussian() * 100;
+    r.update({a, b, 1.0}, -0.96 * a + 0.1 * b + 5.0);
+  }
+  const auto eta = r.eta();
+  // parked: the regressor is constant (y at steady state, v fixed) or zero; y consistent with the model
+  const std::array<double, 3> phi = constant_phi ? std::array<double, 3>{-250.0, 400.0, 1.0}
+                                                 : std::array<double, 3>{0.0, 0.0, 0.0};
+  const double y = r.predict(phi);
+  double max_trace = 0;
+  for (int k = 0; k < 1000000; ++k) {
+    r.update(phi, y);
+    max_trace = std::max(max_trace, r.trace());
+  }
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(r.eta(i), eta[i], 1e-9 * (1 + std::fabs(eta[i])));
+    for (int j = 0; j < 3; ++j) EXPECT_TRUE(std::isfinite(r.P()[i][j]));
+  }
+  EXPECT_TRUE(std::isfinite(max_trace));
+  EXPECT_LE(max_trace, 1e8 + 1.0);
+  // P stays positive semi-definite on its diagonal
+  for (int i = 0; i < 3; ++i) EXPECT_GE(r.P()[i][i], 0.0);
+}
+
+TEST(Rls, ZeroExcitationExponentialTraceBound) { zero_excitation(Forgetting::exponential, false); }
+TEST(Rls, ConstantRegressorExponentialTraceBound) { zero_excitation(Forgetting::exponential, true); }
+TEST(Rls, ZeroExcitationDirectional) { zero_excitation(Forgetting::directional, false); }
+TEST(Rls, ConstantRegressorDirectional) { zero_excitation(Forgetting::directional, true); }
+
+TEST(Rls, DirectionalWithLambdaOneIsPlainRls) {
+  RlsConfig<3> a, b;
+  a.lambda = b.lambda = 1.0;
+  b.forgetting = Forgetting::directional;
+  Rls<3> ra(a), rb(b);
+  Rng rng(11);
+  for (int k = 0; k < 100; ++k) {
+    const std::array<double, 3> phi{rng.gaussian(), rng.gaussian(), 1.0};
+    const double y = rng.gaussian();
+    ra.update(phi, y);
+    rb.update(phi, y);
+  }
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(ra.eta(i), rb.eta(i), 1e-10);
+}
+
+TEST(Rls, DirectionalForgettingTracksAChange) {
+  RlsConfig<2> c;
+  c.lambda = 0.95;
+  c.forgetting = Forgetting::directional;
+  Rls<2> r(c);
+  Rng rng(5);
+  for (int k = 0; k < 6000; ++k) {
+    const double x = rng.gaussian();
+    const double gain = k < 1000 ? 2.0 : 3.0;
+    r.update({x, 1.0}, gain * x + 1.0);
+    if (k == 999) {
+      EXPECT_NEAR(r.eta(0), 2.0, 1e-6);
+    }
+  }
+  // the information along each direction saturates at (1 − λ)/λ, so old data is forgotten
+  EXPECT_NEAR(r.eta(0), 3.0, 1e-4);
+  EXPECT_NEAR(r.eta(1), 1.0, 1e-4);
+}
+
+// ------------------------------------------------------------------------------------------ E1
+
+EstimatorConfig thesis_config() {
+  EstimatorConfig c;
+  c.model = ModelKind::deadzone_deadband;
+  c.dt_s = 0.005;
+  c.guess_left = -350;
+  c.guess_right = 350;
+  c.rls.lambda = 0.99;
+  c.rls.p0 = 1000;
+  c.rls.eta0 = {1, 1, 1};
+  return c;
+}
+
+struct Truth {
+  double a1r, b1r, cr, dr, a1l, b1l, cl, dl;
+};
+
+void expect_dzdb(const AnyEstimator& e, const Truth& t, double tol, const std::string& when) {
+  const SideParams r = e.params(Side::right), l = e.params(Side::left);
+  ASSERT_TRUE(r.identified && l.identified) << when;
+  EXPECT_LE(rel_err(r.a1, t.a1r), tol) << when << " a1_r " << r.a1;
+  EXPECT_LE(rel_err(r.b1, t.b1r), tol) << when << " b1_r " << r.b1;
+  EXPECT_LE(rel_err(r.c, t.cr), tol) << when << " c_r " << r.c;
+  EXPECT_LE(rel_err(r.d, t.dr), tol) << when << " d_r " << r.d;
+  EXPECT_LE(rel_err(l.a1, t.a1l), tol) << when << " a1_l " << l.a1;
+  EXPECT_LE(rel_err(l.b1, t.b1l), tol) << when << " b1_l " << l.b1;
+  EXPECT_LE(rel_err(l.c, t.cl), tol) << when << " c_l " << l.c;
+  EXPECT_LE(rel_err(l.d, t.dl), tol) << when << " d_l " << l.d;
+}
+
+TEST(Estimators, E1NoiseFreeThesisEq34) {
+  Plant plant = load_plant(std::string(LASH_SOURCE_DIR) + "/config/plants/thesis_eq34.toml");
+  SimulationSpec spec;
+  spec.input.kind = Waveform::sine;
+  spec.input.amplitude = 600;
+  spec.input.frequency_rad_s = 1;
+  spec.duration_s = 200;
+  const SimulationTrace tr = simulate(plant, spec);
+  AnyEstimator e(thesis_config());
+  const Truth truth{-0.96, 0.1, 200, 30, -0.94, 0.15, -300, 50};
+  const auto& v = tr.col("v");
+  const auto& y = tr.col("y");
+  for (std::size_t k = 0; k < tr.samples(); ++k) {
+    e.step(v[k], y[k]);
+    if (k + 1 == 10000) expect_dzdb(e, truth, 0.005, "at 50 s");
+  }
+  expect_dzdb(e, truth, 1e-4, "at 200 s");
+  EXPECT_TRUE(e.identified());
+  // the free-run model reproduces the plant output after convergence
+  EXPECT_NEAR(e.simulated(), y.back(), 1e-3 * 1000);
+}
+
+// ---------------------------------------------- each estimator recovers its own model exactly
+// Plants other than the thesis's: different parameters, sample times and inputs; noise-free.
+
+struct Record {
+  std::vector<double> v, y;
+};
+
+Record run_plant(std::vector<Block> blocks, double dt, SignalSpec in, double duration) {
+  Plant plant(std::move(blocks), dt);
+  SimulationSpec spec;
+  spec.input = in;
+  spec.duration_s = duration;
+  spec.seed = in.seed;
+  const SimulationTrace tr = simulate(plant, spec);
+  return {tr.col("v"), tr.col("y")};
+}
+
+AnyEstimator estimate(const EstimatorConfig& c, const Record& r) {
+  AnyEstimator e(c);
+  for (std::size_t k = 0; k < r.v.size(); ++k) e.step(r.v[k], r.y[k]);
+  return e;
+}
+
+EstimatorConfig base(ModelKind m, double dt) {
+  EstimatorConfig c;
+  c.model = m;
+  c.dt_s = dt;
+  c.rls.lambda = 1.0;
+  c.rls.p0 = 1e8;
+  c.rls.eta0 = {0, 0, 0};
+  return c;
+}
+
+TEST(Estimators, LinearRecoversItsModel) {
+  // G = 0.5/(z − 0.9) both sides, T = 0.01, randomized input
+  std::vector<Block> b;
+  b.emplace_back(FirstOrder(PerSide<FirstOrderParams>::both({-0.9, 0.5})));
+  SignalSpec in;
+  in.kind = Waveform::randomized;
+  in.seed = 4;
+  const Record r = run_plant(std::move(b), 0.01, in, 30);
+  const AnyEstimator e = estimate(base(ModelKind::linear, 0.01), r);
+  const SideParams p = e.params(Side::right);
+  ASSERT_TRUE(p.identified);
+  EXPECT_NEAR(p.a1, -0.9, 1e-8);
+  EXPECT_NEAR(p.b1, 0.5, 1e-8);
+  EXPECT_NEAR(e.simulated(), r.y.back(), 1e-6 * (1 + std::fabs(r.y.back())));
+}
+
+TEST(Estimators, InputDeadzoneRecoversItsModel) {
+  // DZ(−1.5, 0.8) → G_r = 0.3/(z − 0.8), G_l = 0.45/(z − 0.7); T = 0.001; triangle 5 at 3 rad/s
+  std::vector<Block> b;
+  b.emplace_back(Deadzone({-1.5, 0.8}));
+  b.emplace_back(FirstOrder({{-0.8, 0.3}, {-0.7, 0.45}}));
+  SignalSpec in;
+  in.kind = Waveform::triangle;
+  in.amplitude = 5;
+  in.frequency_rad_s = 3;
+  const Record r = run_plant(std::move(b), 0.001, in, 10);
+  EstimatorConfig c = base(ModelKind::input_deadzone, 0.001);
+  c.guess_left = -2;
+  c.guess_right = 2;
+  const AnyEstimator e = estimate(c, r);
+  const SideParams pr = e.params(Side::right), pl = e.params(Side::left);
+  ASSERT_TRUE(pr.identified && pl.identified);
+  EXPECT_NEAR(pr.a1, -0.8, 1e-8);
+  EXPECT_NEAR(pr.b1, 0.3, 1e-8);
+  EXPECT_NEAR(pr.c, 0.8, 1e-7);
+  EXPECT_NEAR(pl.a1, -0.7, 1e-8);
+  EXPECT_NEAR(pl.b1, 0.45, 1e-8);
+  EXPECT_NEAR(pl.c, -1.5, 1e-7);
+}
+
+TEST(Estimators, OutputDeadzoneRecoversItsModel) {
+  // G = 0.2/(z − 0.95) → DZ(−0.5, 0.3); T = 0.002; sine 6 at 4 rad/s
+  std::vector<Block> b;
+  b.emplace_back(FirstOrder(PerSide<FirstOrderParams>::both({-0.95, 0.2})));
+  b.emplace_back(Deadzone({-0.5, 0.3}));
+  SignalSpec in;
+  in.amplitude = 6;
+  in.frequency_rad_s = 4;
+  const Record r = run_plant(std::move(b), 0.002, in, 10);
+  const AnyEstimator e = estimate(base(ModelKind::output_deadzone, 0.002), r);
+  const SideParams pr = e.params(Side::right), pl = e.params(Side::left);
+  ASSERT_TRUE(pr.identified && pl.identified);
+  EXPECT_NEAR(pr.a1, -0.95, 1e-8);
+  EXPECT_NEAR(pr.b1, 0.2, 1e-8);
+  EXPECT_NEAR(pr.c, 0.3, 1e-6);
+  EXPECT_NEAR(pl.a1, -0.95, 1e-8);
+  EXPECT_NEAR(pl.b1, 0.2, 1e-8);
+  EXPECT_NEAR(pl.c, -0.5, 1e-6);
+  EXPECT_NEAR(e.simulated(), r.y.back(), 1e-6);
+}
+
+Record dzdb_other_plant() {
+  // DZ(−100, 50) → G_r = 0.2/(z − 0.9), G_l = 0.3/(z − 0.85) → DB(d_r = 5, d_l = 8); T = 0.01; triangle 400 at 2 rad/s
+  std::vector<Block> b;
+  b.emplace_back(Deadzone({-100, 50}));
+  b.emplace_back(FirstOrder({{-0.9, 0.2}, {-0.85, 0.3}}));
+  b.emplace_back(Deadband({5, 8}));
+  SignalSpec in;
+  in.kind = Waveform::triangle;
+  in.amplitude = 400;
+  in.frequency_rad_s = 2;
+  return run_plant(std::move(b), 0.01, in, 60);
+}
+
+void expect_dzdb_other(const AnyEstimator& e, double tol) {
+  const SideParams pr = e.params(Side::right), pl = e.params(Side::left);
+  ASSERT_TRUE(pr.identified && pl.identified);
+  EXPECT_NEAR(pr.a1, -0.9, tol);
+  EXPECT_NEAR(pr.b1, 0.2, tol);
+  EXPECT_NEAR(pr.c, 50, 1e3 * tol);
+  EXPECT_NEAR(pr.d, 5, 1e3 * tol);
+  EXPECT_NEAR(pl.a1, -0.85, tol);
+  EXPECT_NEAR(pl.b1, 0.3, tol);
+  EXPECT_NEAR(pl.c, -100, 1e3 * tol);
+  EXPECT_NEAR(pl.d, 8, 1e3 * tol);
+}
+
+TEST(Estimators, DeadzoneDeadbandRecoversItsModel) {
+  const Record r = dzdb_other_plant();
+  EstimatorConfig c = base(ModelKind::deadzone_deadband, 0.01);
+  c.guess_left = -150;
+  c.guess_right = 150;
+  c.sim_side_by_sign = true;  // the plant's rule (eq. 34), so the free run is exact too
+  const AnyEstimator e = estimate(c, r);
+  expect_dzdb_other(e, 1e-8);
+  const auto* d = e.get<DeadzoneDeadbandEstimator>();
+  ASSERT_NE(d, nullptr);
+  EXPECT_GT(d->updates(Side::right, true), 100u);
+  EXPECT_GT(d->updates(Side::left, false), 100u);
+  EXPECT_NEAR(e.simulated(), r.y.back(), 1e-5);
+}
+
+TEST(Estimators, DeadzoneDeadbandPooledAndIvRecoverItsModel) {
+  const Record r = dzdb_other_plant();
+  EstimatorConfig c = base(ModelKind::deadzone_deadband, 0.01);
+  c.guess_left = -150;
+  c.guess_right = 150;
+  c.pooled = true;
+  expect_dzdb_other(estimate(c, r), 1e-8);
+  c.method = EstimationMethod::iv;
+  expect_dzdb_other(estimate(c, r), 1e-6);
+  c.pooled = false;
+  expect_dzdb_other(estimate(c, r), 1e-6);
+}
+
+TEST(Estimators, DeadzoneDeadbandNotIdentifiedBeforeEnoughData) {
+  const Record r = dzdb_other_plant();
+  EstimatorConfig c = base(ModelKind::deadzone_deadband, 0.01);
+  c.guess_left = -150;
+  c.guess_right = 150;
+  c.min_updates = 10;
+  AnyEstimator e(c);
+  // the first 0.5 s: the input has not left the right guess long enough in both directions
+  for (std::size_t k = 0; k < 50; ++k) e.step(r.v[k], r.y[k]);
+  const SideParams pl = e.params(Side::left);
+  EXPECT_FALSE(pl.identified);
+  EXPECT_TRUE(std::isnan(pl.c));
+  EXPECT_TRUE(std::isnan(pl.d));
+  EXPECT_FALSE(e.identified());
+}
+
+TEST(Estimators, NonFiniteSampleSkipped) {
+  const Record r = dzdb_other_plant();
+  EstimatorConfig c = base(ModelKind::deadzone_deadband, 0.01);
+  c.guess_left = -150;
+  c.guess_right = 150;
+  AnyEstimator e(c);
+  for (std::size_t k = 0; k < 1000; ++k) e.step(r.v[k], r.y[k]);
+  const SideParams before = e.params(Side::right);
+  EXPECT_TRUE(std::isnan(e.step(std::numeric_limits<double>::quiet_NaN(), 1.0)));
+  const SideParams after = e.params(Side::right);
+  EXPECT_EQ(before.a1, after.a1);
+  EXPECT_EQ(e.report().skipped, 1u);
+}
+
+TEST(Estimators, GuessesInsideOutRejected) {
+  EstimatorConfig c = base(ModelKind::deadzone_deadband, 0.01);
+  c.guess_left = 100;
+  c.guess_right = -100;
+  EXPECT_THROW(AnyEstimator{c}, std::invalid_argument);
+  c.guess_left = c.guess_right = 0;
+  EXPECT_THROW(AnyEstimator{c}, std::invalid_argument);
+}
+
+TEST(Estimators, CoupledCartsRecoversItsModel) {
+  // Motor cart velocity: x = G(u), G = 0.05/(z − 0.98); ẇ = DZ(x; −0.04, 0.03) [m/s];
+  // w(k) = w(k−1) + T·ẇ(k) (eq. 39–40); free cart y = DB(w; d = 0.02 m). T = 0.001, u = 6 sin(2t) V.
+  const double dt = 0.001, a1 = -0.98, b1 = 0.05, cl = -0.04, cr = 0.03, d = 0.02;
+  Deadband db({d, d});
+  std::vector<double> v, y;
+  double x = 0, w = 0, u1 = 0;
+  for (int k = 0; k < 30000; ++k) {
+    const double u = 6.0 * std::sin(2.0 * k * dt);
+    x = -a1 * x + b1 * u1;
+    const double wdot = x > cr ? x - cr : (x < cl ? x - cl : 0.0);
+    w += dt * wdot;
+    v.push_back(u);
+    y.push_back(db.step(w));
+    u1 = u;
+  }
+  EstimatorConfig c = base(ModelKind::coupled_carts, dt);
+  c.stage2_start_s = 7.5;
+  AnyEstimator e(c);
+  for (std::size_t k = 0; k < v.size(); ++k) e.step(v[k], y[k]);
+  const SideParams pr = e.params(Side::right), pl = e.params(Side::left);
+  ASSERT_TRUE(e.identified());
+  EXPECT_NEAR(pr.a1, a1, 1e-6);
+  EXPECT_NEAR(pr.b1, b1, 1e-6);
+  EXPECT_NEAR(pr.c, cr, 1e-5);
+  EXPECT_NEAR(pl.a1, a1, 1e-6);
+  EXPECT_NEAR(pl.b1, b1, 1e-6);
+  EXPECT_NEAR(pl.c, cl, 1e-5);
+  EXPECT_NEAR(pr.d, d, 1e-5);
+  EXPECT_NEAR(e.simulated(), y.back(), 1e-4);
+}
+
+}  // namespace
+}  // namespace lash
