@@ -31,6 +31,7 @@ Command add_closed_loop(CLI::App& app);
 Command add_tune(CLI::App& app);
 Command add_identify_steps(CLI::App& app);
 Command add_can(CLI::App& app);
+Command add_hil(CLI::App& app);
 
 /// Runs `fn`, mapping InputError and std::invalid_argument to exit 2 with a message on stderr.
 int guarded(const std::function<int()>& fn);

@@ -1,4 +1,5 @@
 // lash can: dump | send | encode | decode | replay (see docs/can.md).
+#include <sched.h>
 #include <time.h>
 
 #include <atomic>
@@ -6,6 +7,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <map>
 #include <memory>
 
@@ -227,28 +229,54 @@ struct ReplayOptions {
   std::string bus;
   std::string log;
   double speed = 1.0;
+  double spin_us = 2000.0;
+  int rt_priority = 0;
 };
+
+std::int64_t to_ns(const timespec& t) { return static_cast<std::int64_t>(t.tv_sec) * 1000000000LL + t.tv_nsec; }
+timespec from_ns(std::int64_t ns) {
+  timespec t{};
+  t.tv_sec = static_cast<time_t>(ns / 1000000000LL);
+  t.tv_nsec = static_cast<long>(ns % 1000000000LL);
+  return t;
+}
+std::int64_t now_ns() {
+  timespec t{};
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return to_ns(t);
+}
 
 int run_replay(const ReplayOptions& o) {
   const auto entries = can::read_log(o.log);
   if (!(o.speed > 0)) throw InputError("", 0, "--speed", "must be > 0");
   auto bus = can::open_bus(o.bus);
   if (entries.empty()) return kExitOk;
+  if (o.rt_priority > 0) {
+    sched_param sp{};
+    sp.sched_priority = o.rt_priority;
+    if (sched_setscheduler(0, SCHED_FIFO, &sp) != 0)
+      fmt::print(stderr, "lash can replay: cannot use SCHED_FIFO {} ({}); continuing without\n", o.rt_priority,
+                 std::strerror(errno));
+  }
   install_stop_handler();
-  timespec t0{};
-  clock_gettime(CLOCK_MONOTONIC, &t0);
+  // Every frame, the first included, goes out at an absolute deadline; the 10 ms lead
+  // lets the first one take the same (warm) path as the rest.
+  timespec t0 = from_ns(now_ns() + 10000000);
   const double log0 = entries.front().frame.timestamp_s;
   std::size_t failed = 0;
   for (const auto& e : entries) {
     if (g_stop.load()) break;
     const double dt = (e.frame.timestamp_s - log0) / o.speed;
-    if (dt > 0) {
-      const auto off_ns = static_cast<std::int64_t>(std::llround(dt * 1e9));
-      timespec at{};
-      std::int64_t ns = t0.tv_nsec + off_ns % 1000000000LL;
-      at.tv_sec = t0.tv_sec + static_cast<time_t>(off_ns / 1000000000LL) + static_cast<time_t>(ns / 1000000000LL);
-      at.tv_nsec = static_cast<long>(ns % 1000000000LL);
-      while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &at, nullptr) == EINTR && !g_stop.load()) {
+    {
+      // Absolute deadline t0 + dt: sleep until --spin-us before it, then spin on the clock,
+      // so that timer wake-up latency does not delay the frame.
+      const std::int64_t deadline = to_ns(t0) + static_cast<std::int64_t>(std::llround(dt * 1e9));
+      const std::int64_t wake = deadline - static_cast<std::int64_t>(o.spin_us * 1e3);
+      const timespec at = from_ns(wake);
+      while (now_ns() < wake && clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &at, nullptr) == EINTR &&
+             !g_stop.load()) {
+      }
+      while (now_ns() < deadline) {
       }
     }
     if (!bus->send(e.frame)) ++failed;
@@ -291,6 +319,10 @@ Command add_can(CLI::App& app) {
   auto* r = sub->add_subcommand("replay", "Send the frames of a candump -L log with their original timing");
   r->add_option("--bus", rep->bus, "Bus address")->required();
   r->add_option("--speed", rep->speed, "Time scale (2 = twice as fast)");
+  r->add_option("--spin-us", rep->spin_us, "Busy-wait this long before each deadline [us] (default 2000)")
+      ->check(CLI::Range(0.0, 1e6));
+  r->add_option("--rt-priority", rep->rt_priority, "Run under SCHED_FIFO with this priority (1-99; needs privileges)")
+      ->check(CLI::Range(0, 99));
   r->add_option("log", rep->log, "candump -L log file")->required();
   return {sub, [=] {
             if (d->parsed()) return run_dump(*dump);

@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
       add_tune(app),
       add_identify_steps(app),
       add_can(app),
+      add_hil(app),
   };
   try {
     app.parse(argc, argv);

@@ -246,6 +246,7 @@ DecodeStatus decode_datagram(std::span<const std::uint8_t> in, Frame& out) noexc
   bool have_dlc = false;
   std::uint64_t dlc = 0;
   bool error_frame = false;
+  bool fd_only_flag = false;
   std::size_t data_len = 0;
   std::uint8_t data[Frame::kMaxFdLen];
   bool bad_value = false;
@@ -279,6 +280,7 @@ DecodeStatus decode_datagram(std::span<const std::uint8_t> in, Frame& out) noexc
       if (key_is(k, "is_remote_frame")) f.remote = v.b;
       if (key_is(k, "is_error_frame")) error_frame = v.b;
       if (key_is(k, "is_fd")) f.fd = v.b;
+      if ((key_is(k, "bitrate_switch") || key_is(k, "error_state_indicator")) && v.b) fd_only_flag = true;
     } else if (key_is(k, "channel")) {
       // nil, a string or an int: ignored
     } else if (key_is(k, "dlc")) {
@@ -321,6 +323,7 @@ DecodeStatus decode_datagram(std::span<const std::uint8_t> in, Frame& out) noexc
   if (!r.at_end()) return DecodeStatus::malformed;
   if (bad_value) return DecodeStatus::invalid;
   if (error_frame) return DecodeStatus::error_frame;
+  if (fd_only_flag && !f.fd) return DecodeStatus::invalid;  // python-can: BRS/ESI need CAN FD
   if (!have_dlc) dlc = data_len;
   // python-can's Message(check=True) rules.
   if (f.remote) {

@@ -1,0 +1,50 @@
+#pragma once
+/// @file report.hpp
+/// What `lash hil run` reports from the nodes' logs: the emulated trace against the
+/// simulation through the same step functions, and the step-response figures of the
+/// thesis (paper 2 §2.7.2: 90 % rise, 10 % settling, overshoot). Not real-time code.
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "lash/hil/nodes.hpp"
+
+namespace lash::hil {
+
+/// The first reference step (a jump between two samples) whose previous level was held
+/// for at least min_hold_s; the window ends at the next jump or at the end of the trace.
+struct StepWindow {
+  std::size_t begin = 0;  ///< first sample at the new level
+  std::size_t end = 0;    ///< one past the last sample of the window
+  double t_step_s = 0.0;
+  double y0 = 0.0;        ///< reference level before the step
+  double y1 = 0.0;        ///< reference level after the step
+};
+std::optional<StepWindow> find_step(const std::vector<double>& reference, double dt_s, double min_hold_s = 0.5);
+
+/// Thesis step-response figures of samples y at times t (t ≥ t_step), step y0 → y1:
+/// 90 % rise = first crossing of y0 + 0.9(y1 − y0) (interpolated), 10 % settling = last exit
+/// from |y − y1| ≤ 0.1|y1 − y0| (interpolated; 0 if never outside), overshoot = max over the
+/// window of (y − y1)/(y1 − y0) in percent (≥ 0). Times are measured from t_step. NaN rise
+/// when never reached.
+struct StepResponse {
+  double rise_s = 0.0;
+  double settling_s = 0.0;
+  double overshoot_pct = 0.0;
+};
+StepResponse step_response(const std::vector<double>& t_s, const std::vector<double>& y, double t_step_s, double y0,
+                           double y1);
+
+struct SimulationDiff {
+  std::size_t compared = 0;               ///< control steps compared
+  double max_abs_diff_kPa = 0.0;          ///< max |measured_emulated − measured_simulated|
+  double max_abs_diff_mA = 0.0;           ///< max |current_emulated − current_simulated|
+  std::optional<std::int64_t> first_diff_step;  ///< first control step where they differ
+};
+/// Compares emulated master rows (control_step ≥ 0) with the simulation's, by control step.
+SimulationDiff compare_with_simulation(const std::vector<std::int64_t>& control_step,
+                                       const std::vector<double>& measured_kPa, const std::vector<double>& current_mA,
+                                       const std::vector<MasterStepLog>& simulated);
+
+}  // namespace lash::hil

@@ -1,0 +1,144 @@
+#pragma once
+/// @file periodic.hpp
+/// Fixed-step periodic loop on absolute deadlines (SPEC B4, thesis paper 2 §2.7.3:
+/// the xPC target ran the model every 5 ms and logged its task execution time).
+///
+/// Step k is released at r_k = start + k·T and the loop sleeps with
+/// clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, r_k), so releases never drift.
+/// Each step records
+///   - the wake-up latency  s_k − r_k   (s_k = time the step starts),
+///   - the task execution time (TET)  e_k − s_k  (e_k = time the step returns),
+/// into a buffer preallocated for the whole run (no allocation on the sample path).
+/// An overrun is a step that misses its deadline r_k + T: it starts after it
+/// (released late by more than a period) or is still running at it. Overruns
+/// are counted and timestamped; a late step is run at once (the grid is kept,
+/// releases are not skipped) and, by policy, the loop is either tolerant or
+/// stops after N consecutive overruns.
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace lash::rt {
+
+/// Current CLOCK_MONOTONIC time [ns]. noexcept, vDSO, no allocation.
+std::int64_t monotonic_ns() noexcept;
+/// Sleeps until the absolute CLOCK_MONOTONIC time `t_ns` (restarts after EINTR unless `stop` is set).
+void sleep_until_ns(std::int64_t t_ns, const std::atomic<bool>* stop = nullptr) noexcept;
+
+enum class OverrunPolicy : std::uint8_t { tolerate, stop };
+
+struct LoopConfig {
+  std::int64_t period_ns = 5'000'000;      ///< T [ns]
+  std::size_t max_steps = 0;               ///< steps to run = size of the preallocated record buffer (> 0)
+  std::int64_t start_ns = 0;               ///< absolute CLOCK_MONOTONIC time of r_0 [ns]; 0 = now + T
+  int fifo_priority = 0;                   ///< SCHED_FIFO priority 1–99; 0 keeps the default scheduler
+  bool lock_memory = false;                ///< mlockall(MCL_CURRENT | MCL_FUTURE) and pre-fault the stack
+  int cpu = -1;                            ///< pin to this CPU; −1 = no affinity change
+  OverrunPolicy policy = OverrunPolicy::tolerate;
+  std::size_t max_consecutive_overruns = 10;  ///< policy stop: stop after this many in a row (≥ 1)
+};
+
+/// One step as it happened.
+struct StepRecord {
+  std::int64_t release_ns = 0;       ///< r_k − start [ns]
+  std::int64_t wake_latency_ns = 0;  ///< s_k − r_k [ns]
+  std::int64_t tet_ns = 0;           ///< e_k − s_k [ns]
+};
+
+/// A step that missed its deadline.
+struct OverrunEvent {
+  std::size_t step = 0;
+  std::int64_t t_ns = 0;     ///< start of the step relative to start [ns]
+  std::int64_t late_ns = 0;  ///< e_k − (r_k + T) [ns] (> 0)
+};
+
+/// Sample statistics of one quantity.
+struct Summary {
+  std::size_t n = 0;
+  double mean = 0, min = 0, max = 0, std = 0, p99 = 0;  ///< std: sample standard deviation (n − 1)
+};
+/// mean/min/max/std and the 99th percentile (nearest rank: the ⌈0.99·n⌉-th smallest).
+Summary summarize(std::span<const double> values);
+
+enum class StopReason : std::uint8_t { completed, requested, step_returned_false, overruns };
+const char* to_string(StopReason r) noexcept;
+
+struct RunResult {
+  std::size_t steps = 0;
+  std::size_t overruns = 0;
+  StopReason reason = StopReason::completed;
+};
+
+class PeriodicLoop {
+ public:
+  /// Validates the configuration (throws std::invalid_argument) and preallocates the buffers.
+  explicit PeriodicLoop(LoopConfig cfg);
+
+  /// Applies SCHED_FIFO, mlockall and CPU affinity as configured. What is not permitted
+  /// (EPERM, no such CPU, RLIMIT_MEMLOCK) is skipped and reported as a warning; the loop
+  /// still runs with the default settings. Not real-time safe.
+  std::vector<std::string> apply_realtime_settings();
+
+  /// Runs step(k, t_ns) for k = 0, 1, … at the releases; `step` must be noexcept and return
+  /// false to stop. t_ns is the step's start relative to start. Stops early when `stop` becomes
+  /// true (checked at every step boundary and while sleeping).
+  template <class Step>
+  RunResult run(Step&& step, const std::atomic<bool>& stop) noexcept {
+    const std::int64_t T = cfg_.period_ns;
+    start_ns_ = cfg_.start_ns != 0 ? cfg_.start_ns : monotonic_ns() + T;
+    n_records_ = 0;
+    n_overruns_ = 0;
+    RunResult res;
+    std::size_t consecutive = 0;
+    for (std::size_t k = 0; k < cfg_.max_steps; ++k) {
+      const std::int64_t r = start_ns_ + static_cast<std::int64_t>(k) * T;
+      sleep_until_ns(r, &stop);
+      if (stop.load(std::memory_order_relaxed)) {
+        res.reason = StopReason::requested;
+        break;
+      }
+      const std::int64_t s = monotonic_ns();
+      const bool keep_going = step(k, s - start_ns_);
+      const std::int64_t e = monotonic_ns();
+      records_[n_records_++] = StepRecord{r - start_ns_, s - r, e - s};
+      const std::int64_t deadline = r + T;
+      if (e > deadline) {
+        overruns_[n_overruns_++] = OverrunEvent{k, s - start_ns_, e - deadline};
+        if (++consecutive >= cfg_.max_consecutive_overruns && cfg_.policy == OverrunPolicy::stop) {
+          res.reason = StopReason::overruns;
+          break;
+        }
+      } else {
+        consecutive = 0;
+      }
+      if (!keep_going) {
+        res.reason = StopReason::step_returned_false;
+        break;
+      }
+    }
+    res.steps = n_records_;
+    res.overruns = n_overruns_;
+    return res;
+  }
+
+  const LoopConfig& config() const noexcept { return cfg_; }
+  std::int64_t start_ns() const noexcept { return start_ns_; }
+  std::span<const StepRecord> records() const noexcept { return {records_.data(), n_records_}; }
+  std::span<const OverrunEvent> overruns() const noexcept { return {overruns_.data(), n_overruns_}; }
+  /// TET and wake-up latency statistics over the recorded steps [µs].
+  Summary tet_us() const;
+  Summary wake_latency_us() const;
+
+ private:
+  LoopConfig cfg_;
+  std::int64_t start_ns_ = 0;
+  std::vector<StepRecord> records_;
+  std::vector<OverrunEvent> overruns_;
+  std::size_t n_records_ = 0;
+  std::size_t n_overruns_ = 0;
+};
+
+}  // namespace lash::rt

@@ -1,0 +1,140 @@
+#include "lash/rt/periodic.hpp"
+
+#include <sched.h>
+#include <sys/mman.h>
+#include <sys/resource.h>
+#include <time.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+#include <unistd.h>
+
+namespace lash::rt {
+
+std::int64_t monotonic_ns() noexcept {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+void sleep_until_ns(std::int64_t t_ns, const std::atomic<bool>* stop) noexcept {
+  timespec ts{};
+  ts.tv_sec = static_cast<time_t>(t_ns / 1'000'000'000);
+  ts.tv_nsec = static_cast<long>(t_ns % 1'000'000'000);
+  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+    if (stop != nullptr && stop->load(std::memory_order_relaxed)) return;
+  }
+}
+
+Summary summarize(std::span<const double> values) {
+  Summary s;
+  s.n = values.size();
+  if (values.empty()) return s;
+  double sum = 0.0;
+  s.min = values[0];
+  s.max = values[0];
+  for (double v : values) {
+    sum += v;
+    s.min = std::min(s.min, v);
+    s.max = std::max(s.max, v);
+  }
+  s.mean = sum / static_cast<double>(s.n);
+  if (s.n > 1) {
+    double ss = 0.0;
+    for (double v : values) ss += (v - s.mean) * (v - s.mean);
+    s.std = std::sqrt(ss / static_cast<double>(s.n - 1));
+  }
+  std::vector<double> sorted(values.begin(), values.end());
+  // Nearest rank: the ceil(0.99 n)-th smallest value.
+  const auto rank = static_cast<std::size_t>(std::ceil(0.99 * static_cast<double>(s.n)));
+  const std::size_t idx = std::clamp<std::size_t>(rank, 1, s.n) - 1;
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(idx), sorted.end());
+  s.p99 = sorted[idx];
+  return s;
+}
+
+const char* to_string(StopReason r) noexcept {
+  switch (r) {
+    case StopReason::completed: return "completed";
+    case StopReason::requested: return "requested";
+    case StopReason::step_returned_false: return "step_returned_false";
+    case StopReason::overruns: return "overruns";
+  }
+  return "?";
+}
+
+PeriodicLoop::PeriodicLoop(LoopConfig cfg) : cfg_(cfg) {
+  if (cfg_.period_ns <= 0) throw std::invalid_argument("rt: period must be > 0 ns");
+  if (cfg_.max_steps == 0) throw std::invalid_argument("rt: max_steps must be > 0");
+  if (cfg_.fifo_priority < 0 || cfg_.fifo_priority > 99)
+    throw std::invalid_argument("rt: SCHED_FIFO priority must be in 0..99");
+  if (cfg_.max_consecutive_overruns == 0) throw std::invalid_argument("rt: max_consecutive_overruns must be >= 1");
+  records_.resize(cfg_.max_steps);
+  overruns_.resize(cfg_.max_steps);
+}
+
+namespace {
+// Touch this much stack once so that page faults do not happen on the sample path.
+void prefault_stack() noexcept {
+  volatile unsigned char buf[256 * 1024];
+  for (std::size_t i = 0; i < sizeof buf; i += 4096) buf[i] = 0;
+}
+}  // namespace
+
+std::vector<std::string> PeriodicLoop::apply_realtime_settings() {
+  std::vector<std::string> warnings;
+  if (cfg_.lock_memory) {
+    if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0) {
+      warnings.push_back(std::string("mlockall failed (") + std::strerror(errno) +
+                         "): memory is not locked, page faults may add latency "
+                         "(needs CAP_IPC_LOCK or a larger RLIMIT_MEMLOCK)");
+    } else {
+      prefault_stack();
+      // Touch the preallocated buffers too.
+      std::fill(records_.begin(), records_.end(), StepRecord{});
+      std::fill(overruns_.begin(), overruns_.end(), OverrunEvent{});
+    }
+  }
+  if (cfg_.cpu >= 0) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    const long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
+    if (cfg_.cpu >= CPU_SETSIZE || cfg_.cpu >= ncpu) {
+      warnings.push_back("CPU " + std::to_string(cfg_.cpu) + " does not exist (" + std::to_string(ncpu) +
+                         " online): affinity unchanged");
+    } else {
+      CPU_SET(static_cast<std::size_t>(cfg_.cpu), &set);
+      if (sched_setaffinity(0, sizeof set, &set) != 0)
+        warnings.push_back(std::string("sched_setaffinity failed (") + std::strerror(errno) +
+                           "): affinity unchanged");
+    }
+  }
+  if (cfg_.fifo_priority > 0) {
+    sched_param sp{};
+    sp.sched_priority = cfg_.fifo_priority;
+    if (sched_setscheduler(0, SCHED_FIFO, &sp) != 0)
+      warnings.push_back(std::string("SCHED_FIFO priority ") + std::to_string(cfg_.fifo_priority) + " refused (" +
+                         std::strerror(errno) + "): running with the default scheduler "
+                         "(needs CAP_SYS_NICE or RLIMIT_RTPRIO)");
+  }
+  return warnings;
+}
+
+Summary PeriodicLoop::tet_us() const {
+  std::vector<double> v;
+  v.reserve(n_records_);
+  for (const auto& r : records()) v.push_back(static_cast<double>(r.tet_ns) * 1e-3);
+  return summarize(v);
+}
+
+Summary PeriodicLoop::wake_latency_us() const {
+  std::vector<double> v;
+  v.reserve(n_records_);
+  for (const auto& r : records()) v.push_back(static_cast<double>(r.wake_latency_ns) * 1e-3);
+  return summarize(v);
+}
+
+}  // namespace lash::rt

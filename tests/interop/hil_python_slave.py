@@ -1,0 +1,131 @@
+"""The master runs unchanged against another implementation of the slave (SPEC B5,
+thesis §2.7.4): a python-can (Debian python3-can, udp_multicast interface) node that
+speaks config/hydraulic_bench.dbc through canmatrix — it answers the CCP CONNECT with the
+recorded DTO read by python-can's CanutilsLogReader and sends sensor frames from its own
+simple plant — while `lash hil master` holds a step reference on it. Runs in a private
+network namespace (unshare -n)."""
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "cli"))
+import hil_netns  # noqa: E402
+
+hil_netns.enter_private_netns()
+
+import can  # noqa: E402
+import canmatrix.formats  # noqa: E402
+
+SRC = hil_netns.source_dir()
+db = canmatrix.formats.loadp_flat(os.path.join(SRC, "config", "hydraulic_bench.dbc"))
+CMD = db.frame_by_name("BenchCommand")
+SEN = db.frame_by_name("BenchSensors")
+CRO = db.frame_by_name("CCP_CRO")
+DTO = db.frame_by_name("CCP_DTO")
+recorded = [m for m in can.CanutilsLogReader(os.path.join(SRC, "config", "hil", "ccp_connect.log"))
+            if m.arbitration_id == DTO.arbitration_id.id]
+assert recorded, "no DTO in the recorded log"
+
+T = 0.005
+
+
+class Plant:
+    """Its own simple pilot-valve model: deadzone 288 mA, 2.15 kPa/mA, first-order 0.07 s
+    (exact exponential discretisation), 90.1 kPa bias, no noise."""
+
+    def __init__(self):
+        self.w = 0.0
+        self.a = math.exp(-T / 0.07)
+
+    def step(self, current_mA):
+        z = max(current_mA - 288.0, 0.0)
+        self.w = self.a * self.w + (1 - self.a) * 2.15 * z
+        return 90.1 + self.w
+
+
+stop = threading.Event()
+stats = {"dto": 0, "sensors": 0, "commands": 0}
+
+
+def slave():
+    bus = can.Bus(interface="udp_multicast", channel="239.74.163.2", port=43113, receive_own_messages=False)
+    plant = Plant()
+    current = 0.0
+    try:
+        # Wait for the CONNECT (CRO command byte 0x01), answer with the recorded DTO.
+        while not stop.is_set():
+            msg = bus.recv(0.1)
+            if msg is None or msg.arbitration_id != CRO.arbitration_id.id:
+                continue
+            if CRO.decode(msg.data)["CRO_CMD"].raw_value == 1:
+                for d in recorded:
+                    bus.send(can.Message(arbitration_id=d.arbitration_id, data=d.data, is_extended_id=False))
+                stats["dto"] += 1
+                break
+        t_next = time.monotonic() + T / 2
+        counter = 0
+        while not stop.is_set():
+            delay = t_next - time.monotonic()
+            if delay > 0:
+                time.sleep(delay)
+            t_next += T
+            while True:
+                msg = bus.recv(0)
+                if msg is None:
+                    break
+                if msg.arbitration_id == CMD.arbitration_id.id:
+                    current = float(CMD.decode(msg.data)["SolenoidA_Current"].phys_value)
+                    stats["commands"] += 1
+            p = plant.step(current)
+            duty = p / 48.82 + 5.98
+            raw = min(max(round(duty * 65535 / 100), 0), 65535)  # SPEC B1 sensor code
+            # canmatrix's Frame.encode takes raw signal values and does the bit packing.
+            data = SEN.encode({"PilotPressure_Duty": raw, "SupplyPressure_Duty": 0, "Sensor_Counter": counter % 65536})
+            bus.send(can.Message(arbitration_id=SEN.arbitration_id.id, data=data, is_extended_id=False))
+            counter += 1
+            stats["sensors"] += 1
+    finally:
+        bus.shutdown()
+
+
+th = threading.Thread(target=slave, daemon=True)
+th.start()
+time.sleep(0.5)
+out = tempfile.mkdtemp(prefix="lash_hil_py_")
+r = subprocess.run([hil_netns.lash(), "hil", "master", "--bus", "udp:239.74.163.2:43113", "--duration", "3",
+                    "--reference", "step:from=500,to=1500,time=1", "--log", f"{out}/master.csv",
+                    "--stats", f"{out}/master.json", "--bus-log", f"{out}/master_bus.log"],
+                   capture_output=True, text=True, timeout=60)
+stop.set()
+th.join(2)
+print(r.stderr)
+assert r.returncode == 0, r.stderr
+assert stats["dto"] == 1 and stats["commands"] > 500, stats
+
+m = hil_netns.read_csv(f"{out}/master.csv")
+rows = [i for i, cs in enumerate(m["control_step"]) if cs >= 0]
+t = [m["control_step"][i] * T for i in rows]
+y = [m["measured_kPa"][i] for i in rows]
+i_mA = [m["current_mA"][i] for i in rows]
+assert max(i_mA) <= 2000 and min(i_mA) >= 0
+# Settling into the 10 % band of the 500 -> 1500 kPa step within 0.5 s of the step (thesis
+# simulation: 0.25 s), and then staying there; steady state within 1 % at the end.
+after = [(tt, yy) for tt, yy in zip(t, y) if tt >= 1.0]
+outside = [tt for tt, yy in after if abs(yy - 1500) > 100]
+settling = (max(outside) - 1.0) if outside else 0.0
+tail = [yy for tt, yy in after if tt >= 2.5]
+print(f"python-can slave: settling {settling:.3f} s, final mean {sum(tail) / len(tail):.1f} kPa, "
+      f"{stats['sensors']} sensor frames sent")
+assert settling <= 0.5, settling
+assert abs(sum(tail) / len(tail) - 1500) < 15
+before = [yy for tt, yy in zip(t, y) if 0.7 <= tt < 1.0]
+assert abs(sum(before) / len(before) - 500) < 10
+# The bus log is a candump -L log python-can can read, and it holds the handshake.
+msgs = list(can.CanutilsLogReader(f"{out}/master_bus.log"))
+assert msgs[0].arbitration_id == CRO.arbitration_id.id
+assert any(mm.arbitration_id == DTO.arbitration_id.id for mm in msgs)
+print("ok")
