@@ -1,0 +1,138 @@
+// lash sweep: run a campaign of virtual-rig runs (SPEC A7, E3–E5) in parallel and report NRMSE.
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <set>
+
+#include <fmt/core.h>
+
+#include "cli_common.hpp"
+#include "plot.hpp"
+#include "lash/sweep/campaign.hpp"
+#include "lash/sweep/sweep.hpp"
+
+namespace lash::cli {
+namespace {
+
+struct SweepOptions {
+  std::string campaign;
+  unsigned jobs = 0;
+  std::string out;
+  std::string plot;
+  bool json = false;
+  bool quiet = false;
+};
+
+/// Progress bar on stderr: runs done/total, elapsed, ETA. Redrawn in place on a terminal,
+/// one line per 10 % otherwise (logs stay short).
+class ProgressBar {
+ public:
+  explicit ProgressBar(bool enabled) : enabled_(enabled), tty_(isatty(fileno(stderr)) != 0) {}
+  void operator()(std::size_t done, std::size_t total) {
+    if (!enabled_ || total == 0) return;
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    const double eta = done > 0 ? elapsed * static_cast<double>(total - done) / static_cast<double>(done) : 0.0;
+    const int width = 30;
+    const int fill = static_cast<int>(static_cast<double>(width) * static_cast<double>(done) / static_cast<double>(total));
+    const std::string bar = std::string(static_cast<std::size_t>(fill), '#') + std::string(static_cast<std::size_t>(width - fill), '.');
+    const std::string text = fmt::format("[{}] {}/{} runs  elapsed {:.1f} s  ETA {:.1f} s", bar, done, total, elapsed, eta);
+    if (tty_) {
+      fmt::print(stderr, "\r{}", text);
+      if (done == total) fmt::print(stderr, "\n");
+    } else {
+      const std::size_t decile = done * 10 / total;
+      if (decile != last_decile_ || done == total) {
+        if (done == total && printed_final_) return;
+        fmt::print(stderr, "{}\n", text);
+        last_decile_ = decile;
+        printed_final_ = done == total;
+      }
+    }
+    std::fflush(stderr);
+  }
+
+ private:
+  bool enabled_, tty_;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+  std::size_t last_decile_ = static_cast<std::size_t>(-1);
+  bool printed_final_ = false;
+};
+
+/// Fig. 1.34/1.39/1.44 analogue: NRMSE [%] against frequency, one line per amplitude, one panel
+/// per waveform (randomized runs: NRMSE against run number).
+void plot_sweep(const sweep::Campaign& c, const std::vector<sweep::RunResult>& results, const std::string& csv,
+                const std::string& png) {
+  std::vector<std::string> wfs;
+  std::set<double> amps;
+  for (const auto& r : results) {
+    const std::string w = to_string(r.spec.waveform);
+    if (std::find(wfs.begin(), wfs.end(), w) == wfs.end()) wfs.push_back(w);
+    if (r.spec.waveform != Waveform::randomized) amps.insert(r.spec.amplitude);
+  }
+  std::string s;
+  s += fmt::format("set terminal pngcairo size 900,{} font 'sans,9'\n", 260 * wfs.size() + 40);
+  s += "set output '<OUTPUT>'\nset datafile separator ','\nset grid\nset key outside right\n";
+  s += fmt::format("set multiplot layout {},1 title \"{} (virtual rig): NRMSE {}–{} s\"\n", wfs.size(), c.name,
+                   format_double(c.window_start_s), format_double(c.window_end_s));
+  for (const auto& w : wfs) {
+    s += "set ylabel 'NRMSE [%]'\n";
+    s += fmt::format("set arrow from graph 0, first {} to graph 1, first {} nohead dt 2 lc rgb 'red'\n",
+                     100 * c.good_nrmse, 100 * c.good_nrmse);
+    if (w == "randomized") {
+      s += "set xlabel 'randomized run'\nset title 'randomized'\n";
+      s += fmt::format("plot '{}' using (strcol(2) eq 'randomized' ? $5 : NaN):(100*$7) every ::1 with points pt 7 title 'randomized'\n", csv);
+    } else {
+      s += fmt::format("set xlabel 'frequency [rad/s]'\nset title '{}'\n", w);
+      s += "plot ";
+      bool first = true;
+      for (double a : amps) {
+        if (!first) s += ", ";
+        first = false;
+        s += fmt::format("'{}' using (strcol(2) eq '{}' && $3 == {} ? $4 : NaN):(100*$7) every ::1 with points pt 7 ps 0.8 title 'A = {}'",
+                         csv, w, format_double(a), format_double(a));
+      }
+      s += "\n";
+    }
+    s += "unset arrow\n";
+  }
+  s += "unset multiplot\n";
+  run_gnuplot(s, png);
+}
+
+int run(const SweepOptions& o) {
+  const sweep::Campaign c = sweep::load_campaign(o.campaign);
+  ProgressBar bar(!o.quiet);
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto results = sweep::run_campaign(c, o.jobs, [&](std::size_t d, std::size_t n) { bar(d, n); });
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  sweep::write_results_csv(o.out, c, results);
+  if (!o.plot.empty()) plot_sweep(c, results, o.out, o.plot);
+  const sweep::Summary s = sweep::summarize(c, results);
+  if (o.json) {
+    fmt::print("{}", sweep::summary_json(c, s, results));
+  } else {
+    fmt::print("{}", sweep::summary_text(c, s, results));
+    fmt::print("wall time {:.2f} s ({:.1f} runs/s); results -> {}{}\n", wall,
+               static_cast<double>(results.size()) / wall, o.out, o.plot.empty() ? "" : ", plot -> " + o.plot);
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+Command add_sweep(CLI::App& app) {
+  auto o = std::make_shared<SweepOptions>();
+  auto* sub = app.add_subcommand("sweep", "Run a campaign of virtual-rig runs (E3-E5) in parallel and report NRMSE");
+  sub->add_option("campaign", o->campaign, "Campaign file (TOML, see docs/sweep.md)")->required();
+  sub->add_option("-j,--jobs", o->jobs, "Worker threads (default: all cores)");
+  sub->add_option("-o,--output", o->out, "Results CSV, one row per run")->required();
+  sub->add_option("--plot", o->plot, "Also draw NRMSE against amplitude/frequency per waveform (PNG, gnuplot)");
+  sub->add_flag("--json", o->json, "Print the summary as JSON");
+  sub->add_flag("-q,--quiet", o->quiet, "No progress bar");
+  return {sub, [o] { return run(*o); }};
+}
+
+}  // namespace lash::cli

@@ -1,0 +1,33 @@
+#pragma once
+/// @file mat.hpp
+/// MATLAB .mat files (v4, v5 and — when Debian's libmatio was built with HDF5 —
+/// v7.3) read through libmatio into the same named-column table that
+/// lash::read_csv returns, so every command that reads CSV reads MAT too.
+/// Not real-time safe.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "lash/io/csv.hpp"
+
+namespace lash {
+
+/// Names of the variables stored in a MAT file (file order). Throws InputError if the
+/// file is missing or not a MAT file.
+std::vector<std::string> mat_variable_names(const std::filesystem::path& path);
+
+/// Reads the named numeric variables (real; any MATLAB numeric or logical class) as columns.
+/// Each must be a vector (N×1 or 1×N) of one common length N, or a scalar (1×1), which is
+/// repeated N times. At least one must be a vector. Every value must be finite.
+/// Errors (missing file, missing variable, wrong shape/class, length mismatch, non-finite
+/// value) throw InputError naming the file and the variable.
+/// CsvTable::line_of_row holds the 1-based element index of each row.
+CsvTable read_mat(const std::filesystem::path& path, const std::vector<std::string>& variables);
+
+/// Reads one real scalar (1×1) variable; InputError if absent or not a scalar.
+double read_mat_scalar(const std::filesystem::path& path, const std::string& variable);
+
+/// True if `path` ends in ".mat" (any case): the commands use it to pick the reader.
+bool is_mat_file(const std::filesystem::path& path);
+
+}  // namespace lash

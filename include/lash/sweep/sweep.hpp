@@ -1,0 +1,97 @@
+#pragma once
+/// @file sweep.hpp
+/// Runs a campaign (SPEC A7, E3–E5): every run drives its virtual rig with its
+/// signal, feeds (v, y) sample by sample to the estimator and scores the
+/// estimator's free-run simulated output against the rig's measured output by
+/// NRMSE = RMS(y − y_sim)/max|y| over the campaign's window (SPEC A6, thesis
+/// 7.5–30 s). Runs are independent and run in parallel on a std::thread pool.
+/// Not real-time safe (this is the offline harness around real-time pieces).
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "lash/blocks/side.hpp"
+#include "lash/identify/estimators.hpp"
+#include "lash/sweep/campaign.hpp"
+
+namespace lash::sweep {
+
+inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+/// What one run identified, per side, after the sweep's physical-sense checks.
+struct SideResult {
+  double a1 = kNaN, b1 = kNaN, c = kNaN;
+  double gain = kNaN;    ///< K = b1/(1 + a1)
+  double tau_s = kNaN;   ///< τ = −T/ln(−a1)
+  bool identified = false;
+  std::uint64_t updates = 0;
+  /// Why a side the estimator offered is reported not identified ("" when identified or when
+  /// the estimator itself said so): "unphysical deadzone" (c_r < 0, c_l > 0 or c_l > c_r),
+  /// "input not exciting" (the input took one value on every update: b1 and c inseparable).
+  std::string rejected;
+};
+
+struct RunResult {
+  RunSpec spec;
+  double nrmse = kNaN;       ///< fraction (0.05 = 5 %)
+  double max_abs_y = 0.0;    ///< max |y| over the window [output unit]
+  PerSide<SideResult> side;
+  double d = kNaN;           ///< coupled carts: deadband half-width [m]
+  bool d_identified = false;
+  rigs::EffectiveModel truth;///< the rig's true effective model for this run (docs/rigs.md)
+  /// Largest relative error of the identified K, c (carts: also τ; coupled carts: also d) against
+  /// `truth`; NaN when nothing was identified.
+  double param_error = kNaN;
+  bool good(double threshold) const noexcept { return nrmse < threshold; }
+};
+
+/// Runs one run from scratch (deterministic: same campaign and spec → same bits).
+RunResult run_one(const Campaign& c, const RunSpec& run);
+
+/// Called from the coordinating thread with (runs done, total) about five times a second
+/// and once at the end.
+using ProgressFn = std::function<void(std::size_t done, std::size_t total)>;
+
+/// Runs every run of the campaign on `jobs` threads (0 = all hardware threads). Results come
+/// back in campaign order whatever the scheduling. The first exception of a worker is rethrown.
+std::vector<RunResult> run_campaign(const Campaign& c, unsigned jobs, const ProgressFn& progress = {});
+
+struct WaveformSummary {
+  std::string waveform;
+  std::size_t runs = 0, good = 0;
+  double share_good = 0.0;   ///< good / runs
+  double median_nrmse = kNaN;
+};
+
+struct Summary {
+  std::string campaign;
+  std::size_t runs = 0, good = 0;
+  double threshold = 0.10;
+  double share_good = 0.0;
+  std::vector<WaveformSummary> per_waveform;  ///< in order of first appearance
+  double median_nrmse = kNaN;
+  std::size_t median_index = 0;   ///< run whose NRMSE is the (lower) median
+  std::size_t worst_index = 0;    ///< run with the largest NRMSE (NaN counts as worst)
+  double worst_nrmse = kNaN;
+  std::size_t params_checked = 0; ///< runs with at least one identified side
+  std::size_t params_within = 0;  ///< … whose param_error ≤ tolerance
+  double param_tolerance = 0.05;
+  std::size_t sides_identified = 0, sides_total = 0;
+  std::size_t unphysical_reported = 0;  ///< identified sides with c_l > c_r (must be 0)
+};
+
+Summary summarize(const Campaign& c, const std::vector<RunResult>& results);
+
+/// Human-readable summary (several lines, ends with a newline).
+std::string summary_text(const Campaign& c, const Summary& s, const std::vector<RunResult>& results);
+/// The same summary as one JSON object.
+std::string summary_json(const Campaign& c, const Summary& s, const std::vector<RunResult>& results);
+
+/// Writes one CSV row per run (atomically): waveform, amplitude, frequency_rad_s, repeat, seed,
+/// nrmse, per side a1/b1/c/K/tau/identified/updates, d, d_identified, param_error and the
+/// rig's true K/tau/c per side. Not-identified values are written as "nan".
+void write_results_csv(const std::string& path, const Campaign& c, const std::vector<RunResult>& results);
+
+}  // namespace lash::sweep

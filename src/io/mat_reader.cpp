@@ -1,0 +1,136 @@
+// MAT-file reading through libmatio (Debian libmatio-dev).
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdint>
+#include <memory>
+
+#include <matio.h>
+
+#include "lash/io/error.hpp"
+#include "lash/io/mat.hpp"
+
+namespace lash {
+namespace {
+
+struct MatCloser {
+  void operator()(mat_t* m) const noexcept { Mat_Close(m); }
+};
+struct VarFreer {
+  void operator()(matvar_t* v) const noexcept { Mat_VarFree(v); }
+};
+using MatPtr = std::unique_ptr<mat_t, MatCloser>;
+using VarPtr = std::unique_ptr<matvar_t, VarFreer>;
+
+MatPtr open_mat(const std::filesystem::path& path) {
+  const std::string file = path.string();
+  if (!std::filesystem::exists(path)) throw InputError(file, 0, "", "no such file");
+  MatPtr m(Mat_Open(file.c_str(), MAT_ACC_RDONLY));
+  if (!m) throw InputError(file, 0, "", "not a MATLAB .mat file libmatio can read (v4, v5 or v7.3)");
+  return m;
+}
+
+template <class T>
+void convert(const void* data, std::size_t n, std::vector<double>& out) {
+  const T* p = static_cast<const T*>(data);
+  out.resize(n);
+  for (std::size_t i = 0; i < n; ++i) out[i] = static_cast<double>(p[i]);
+}
+
+/// Reads variable `name` as a flat vector of doubles; `elements` = its element count.
+std::vector<double> read_numeric(mat_t* mat, const std::string& file, const std::string& name, bool& is_scalar) {
+  VarPtr var(Mat_VarRead(mat, name.c_str()));
+  if (!var) throw InputError(file, 0, name, "no variable named '" + name + "' in this MAT file");
+  if (var->isComplex) throw InputError(file, 0, name, "is complex; a real numeric variable is needed");
+  if (var->rank != 2) throw InputError(file, 0, name, "has " + std::to_string(var->rank) + " dimensions; a vector is needed");
+  const std::size_t r = var->dims[0], c = var->dims[1];
+  if (r != 1 && c != 1)
+    throw InputError(file, 0, name,
+                     "is a " + std::to_string(r) + "x" + std::to_string(c) + " matrix; a vector (Nx1 or 1xN) is needed");
+  const std::size_t n = r * c;
+  if (n == 0) throw InputError(file, 0, name, "is empty");
+  if (!var->data) throw InputError(file, 0, name, "has no data");
+  std::vector<double> out;
+  switch (var->class_type) {
+    case MAT_C_DOUBLE: convert<double>(var->data, n, out); break;
+    case MAT_C_SINGLE: convert<float>(var->data, n, out); break;
+    case MAT_C_INT8: convert<std::int8_t>(var->data, n, out); break;
+    case MAT_C_UINT8: convert<std::uint8_t>(var->data, n, out); break;
+    case MAT_C_INT16: convert<std::int16_t>(var->data, n, out); break;
+    case MAT_C_UINT16: convert<std::uint16_t>(var->data, n, out); break;
+    case MAT_C_INT32: convert<std::int32_t>(var->data, n, out); break;
+    case MAT_C_UINT32: convert<std::uint32_t>(var->data, n, out); break;
+    case MAT_C_INT64: convert<std::int64_t>(var->data, n, out); break;
+    case MAT_C_UINT64: convert<std::uint64_t>(var->data, n, out); break;
+    default: throw InputError(file, 0, name, "is not a numeric array (struct, cell, char or sparse)");
+  }
+  if (var->isLogical) {
+    for (auto& x : out) x = x != 0.0 ? 1.0 : 0.0;
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    if (!std::isfinite(out[i]))
+      throw InputError(file, 0, name, "element " + std::to_string(i + 1) + " is not a finite number");
+  is_scalar = n == 1;
+  return out;
+}
+
+}  // namespace
+
+bool is_mat_file(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  return ext == ".mat";
+}
+
+std::vector<std::string> mat_variable_names(const std::filesystem::path& path) {
+  MatPtr mat = open_mat(path);
+  std::vector<std::string> names;
+  while (matvar_t* v = Mat_VarReadNextInfo(mat.get())) {
+    VarPtr guard(v);
+    if (v->name) names.emplace_back(v->name);
+  }
+  return names;
+}
+
+CsvTable read_mat(const std::filesystem::path& path, const std::vector<std::string>& variables) {
+  const std::string file = path.string();
+  if (variables.empty()) throw InputError(file, 0, "", "no variables named to read");
+  MatPtr mat = open_mat(path);
+  CsvTable t;
+  t.file = file;
+  std::vector<bool> scalar(variables.size());
+  std::size_t n = 0;
+  std::string n_from;
+  for (std::size_t i = 0; i < variables.size(); ++i) {
+    bool s = false;
+    t.cols.push_back(read_numeric(mat.get(), file, variables[i], s));
+    t.header.push_back(variables[i]);
+    scalar[i] = s;
+    if (!s) {
+      if (n == 0) {
+        n = t.cols.back().size();
+        n_from = variables[i];
+      } else if (t.cols.back().size() != n) {
+        throw InputError(file, 0, variables[i],
+                         "has " + std::to_string(t.cols.back().size()) + " elements but '" + n_from + "' has " +
+                             std::to_string(n));
+      }
+    }
+  }
+  if (n == 0) throw InputError(file, 0, variables.front(), "every named variable is a scalar; at least one vector is needed");
+  for (std::size_t i = 0; i < variables.size(); ++i)
+    if (scalar[i]) t.cols[i].assign(n, t.cols[i][0]);
+  t.line_of_row.resize(n);
+  for (std::size_t k = 0; k < n; ++k) t.line_of_row[k] = static_cast<int>(k + 1);
+  return t;
+}
+
+double read_mat_scalar(const std::filesystem::path& path, const std::string& variable) {
+  MatPtr mat = open_mat(path);
+  bool s = false;
+  auto v = read_numeric(mat.get(), path.string(), variable, s);
+  if (!s) throw InputError(path.string(), 0, variable, "is a vector; a scalar (1x1) is needed");
+  return v[0];
+}
+
+}  // namespace lash

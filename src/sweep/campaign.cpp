@@ -1,0 +1,231 @@
+#include "lash/sweep/campaign.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "lash/io/error.hpp"
+#include "lash/io/toml_util.hpp"
+
+namespace lash::sweep {
+
+std::uint64_t run_seed(std::uint64_t base, std::size_t index) noexcept {
+  std::uint64_t z = base + 0x9e3779b97f4a7c15ULL * (static_cast<std::uint64_t>(index) + 1);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+namespace {
+
+std::vector<double> nonempty_numbers(TomlTable& t, const char* key, bool positive) {
+  auto v = t.numbers(key);
+  if (v.empty()) t.fail(key, "is empty; the campaign matrix needs at least one value");
+  for (double x : v)
+    if (positive ? !(x > 0) : false) t.fail(key, "every value must be > 0");
+  return v;
+}
+
+void read_estimator(TomlTable& t, EstimatorConfig& e) {
+  if (auto m = t.string_opt("model")) {
+    try {
+      e.model = parse_model_kind(*m);
+    } catch (const std::invalid_argument& ex) {
+      t.fail("model", ex.what());
+    }
+  }
+  auto& r = e.rls;
+  r.lambda = t.number_or("lambda", r.lambda);
+  r.p0 = t.number_or("p0", r.p0);
+  if (auto v = t.numbers_opt("eta0")) {
+    if (v->size() != 3 && v->size() != 2) t.fail("eta0", "needs 3 values [a1, b1, e] (2 for the linear model)");
+    for (std::size_t i = 0; i < v->size(); ++i) r.eta0[i] = (*v)[i];
+  }
+  if (auto f = t.string_opt("forgetting")) {
+    if (*f == "exponential") r.forgetting = Forgetting::exponential;
+    else if (*f == "directional") r.forgetting = Forgetting::directional;
+    else t.fail("forgetting", "expected \"exponential\" or \"directional\"");
+  }
+  r.trace_max = t.number_or("trace_max", r.trace_max);
+  auto bounds = [&](const char* key, std::array<double, 3>& out) {
+    if (auto v = t.numbers_opt(key)) {
+      if (v->size() != 3) t.fail(key, "needs 3 values [a1, b1, e]");
+      for (std::size_t i = 0; i < 3; ++i) out[i] = (*v)[i];
+    }
+  };
+  bounds("lower", r.lower);
+  bounds("upper", r.upper);
+  if (auto g = t.numbers_opt("guesses")) {
+    if (g->size() != 2 || !((*g)[0] < (*g)[1])) t.fail("guesses", "needs [c_l*, c_r*] with c_l* < c_r*");
+    e.guess_left = (*g)[0];
+    e.guess_right = (*g)[1];
+  }
+  if (auto m = t.string_opt("method")) {
+    try {
+      e.method = parse_method(*m);
+    } catch (const std::invalid_argument& ex) {
+      t.fail("method", ex.what());
+    }
+  }
+  auto count = [&](const char* key, auto& field) {
+    if (auto v = t.integer_opt(key)) {
+      if (*v < 0) t.fail(key, "must be >= 0");
+      field = static_cast<std::remove_reference_t<decltype(field)>>(*v);
+    }
+  };
+  count("iv_delay", e.iv_delay);
+  count("min_updates", e.min_updates);
+  if (auto b = t.boolean_opt("pooled")) e.pooled = *b;
+  e.singular_tol = t.number_or("singular_tol", e.singular_tol);
+  e.zero_threshold = t.number_or("zero_threshold", e.zero_threshold);
+  e.accel_limit = t.number_or("accel_limit", e.accel_limit);
+  e.stage2_start_s = t.number_or("stage2_start_s", e.stage2_start_s);
+  if (auto b = t.boolean_opt("sim_side_by_sign")) e.sim_side_by_sign = *b;
+  auto& n = e.noise;
+  count("filter_length", n.filter_length);
+  if (auto b = t.boolean_opt("filter_input")) n.filter_input = *b;
+  count("input_delay", n.input_delay);
+  count("derivative_filter_length", n.derivative_filter_length);
+  n.derivative_threshold = t.number_or("derivative_threshold", n.derivative_threshold);
+  count("align_delay", n.align_delay);
+  t.finish();
+  try {
+    e.validate();
+  } catch (const std::invalid_argument& ex) {
+    throw InputError(t.file(), t.line(), t.path(""), ex.what());
+  }
+}
+
+}  // namespace
+
+EstimatorConfig thesis_estimator(rigs::RigKind kind, double dt_s) {
+  EstimatorConfig e;
+  e.dt_s = dt_s;
+  e.rls.lambda = 0.99;
+  e.rls.p0 = 1000.0;
+  e.rls.eta0 = {1.0, 1.0, 1.0};
+  switch (kind) {
+    case rigs::RigKind::motor_cart: e.model = ModelKind::output_deadzone; break;
+    case rigs::RigKind::pilot_valve:
+      e.model = ModelKind::input_deadzone;
+      e.guess_left = -500.0;
+      e.guess_right = 500.0;
+      e.rls.lower = {-1.0, 0.0001, -500.0};
+      e.rls.upper = {0.0, 2.0, 500.0};
+      break;
+    case rigs::RigKind::coupled_carts:
+      e.model = ModelKind::coupled_carts;
+      e.accel_limit = 1.0;
+      e.stage2_start_s = 7.5;
+      break;
+  }
+  return e;
+}
+
+Campaign load_campaign(const std::filesystem::path& path) {
+  const toml::table root_tbl = parse_toml_file(path);
+  TomlTable root(root_tbl, path.string());
+  Campaign c;
+  c.file = path.string();
+  c.name = root.string_opt("name").value_or(path.stem().string());
+  const std::string rig_name = root.string("rig");
+  rigs::RigKind kind{};
+  try {
+    kind = rigs::parse_rig_kind(rig_name);
+  } catch (const std::invalid_argument& e) {
+    root.fail("rig", e.what());
+  }
+  c.dt_s = root.number("dt_s");
+  if (!(c.dt_s > 0)) root.fail("dt_s", "must be > 0 [s]");
+  c.duration_s = root.number("duration_s");
+  if (!(c.duration_s > 0)) root.fail("duration_s", "must be > 0 [s]");
+  if (c.duration_s / c.dt_s > 1e8) root.fail("duration_s", "more than 1e8 samples per run");
+  if (auto w = root.numbers_opt("nrmse_window_s")) {
+    if (w->size() != 2) root.fail("nrmse_window_s", "needs [start, end] in seconds");
+    c.window_start_s = (*w)[0];
+    c.window_end_s = (*w)[1];
+  } else {
+    c.window_start_s = std::min(7.5, 0.25 * c.duration_s);
+    c.window_end_s = c.duration_s;
+  }
+  if (!(c.window_start_s >= 0 && c.window_end_s > c.window_start_s && c.window_start_s < c.duration_s))
+    root.fail("nrmse_window_s", "needs 0 <= start < end and start < duration_s");
+  c.good_nrmse = root.number_or("good_nrmse", c.good_nrmse);
+  if (!(c.good_nrmse > 0)) root.fail("good_nrmse", "must be > 0 (a fraction: 0.10 = 10 %)");
+  c.param_tolerance = root.number_or("param_tolerance", c.param_tolerance);
+  if (!(c.param_tolerance > 0)) root.fail("param_tolerance", "must be > 0 (a fraction)");
+  if (auto s = root.integer_opt("seed")) {
+    if (*s < 0) root.fail("seed", "must be >= 0");
+    c.seed = static_cast<std::uint64_t>(*s);
+  }
+
+  // The matrix: waveforms × amplitudes × frequencies × repeats.
+  std::size_t matrix_runs = 0;
+  if (auto m = root.table_opt("matrix")) {
+    const auto wf_names = m->strings("waveforms");
+    if (wf_names.empty()) m->fail("waveforms", "is empty; the campaign matrix needs at least one waveform");
+    std::vector<Waveform> wfs;
+    for (const auto& w : wf_names) {
+      Waveform wf{};
+      try {
+        wf = parse_waveform(w);
+      } catch (const std::invalid_argument& e) {
+        m->fail("waveforms", e.what());
+      }
+      if (wf != Waveform::sine && wf != Waveform::square && wf != Waveform::triangle)
+        m->fail("waveforms", "only sine, square and triangle form the matrix (randomized runs go in [randomized])");
+      wfs.push_back(wf);
+    }
+    const auto amps = nonempty_numbers(*m, "amplitudes", true);
+    const auto freqs = nonempty_numbers(*m, "frequencies_rad_s", true);
+    const auto reps = m->integer("repeats");
+    if (reps < 1 || reps > 1000) m->fail("repeats", "must be in 1..1000");
+    m->finish();
+    for (Waveform wf : wfs)
+      for (double a : amps)
+        for (double f : freqs)
+          for (int r = 1; r <= reps; ++r) {
+            RunSpec s;
+            s.waveform = wf;
+            s.amplitude = a;
+            s.frequency_rad_s = f;
+            s.repeat = r;
+            c.runs.push_back(s);
+          }
+    matrix_runs = c.runs.size();
+  }
+  if (auto rt = root.table_opt("randomized")) {
+    const auto n = rt->integer("runs");
+    if (n < 0 || n > 100000) rt->fail("runs", "must be in 0..100000");
+    c.random_variance = rt->number_or("variance", c.random_variance);
+    if (!(c.random_variance > 0)) rt->fail("variance", "must be > 0");
+    c.random_tau_s = rt->number_or("tau_s", c.random_tau_s);
+    if (!(c.random_tau_s > 0)) rt->fail("tau_s", "must be > 0 [s]");
+    rt->finish();
+    for (int r = 1; r <= n; ++r) {
+      RunSpec s;
+      s.waveform = Waveform::randomized;
+      s.repeat = r;
+      c.runs.push_back(s);
+    }
+  }
+  if (c.runs.empty())
+    root.fail(matrix_runs == 0 && root.has("matrix") ? "matrix" : "randomized",
+              "the campaign has no runs: give a [matrix] and/or [randomized] with runs > 0");
+  for (std::size_t i = 0; i < c.runs.size(); ++i) {
+    c.runs[i].index = i;
+    c.runs[i].seed = run_seed(c.seed, i);
+  }
+
+  c.estimator = thesis_estimator(kind, c.dt_s);
+  if (auto e = root.table_opt("estimator")) read_estimator(*e, c.estimator);
+  c.estimator.dt_s = c.dt_s;
+  if (auto rp = root.table_opt("rig_params")) {
+    c.rig = rigs::read_rig_config(kind, &*rp);
+  } else {
+    c.rig = rigs::read_rig_config(kind, nullptr);
+  }
+  root.finish();
+  return c;
+}
+
+}  // namespace lash::sweep

@@ -1,0 +1,277 @@
+#include "lash/sweep/sweep.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <exception>
+#include <mutex>
+#include <thread>
+
+#include "lash/plant/simulate.hpp"
+
+namespace lash::sweep {
+namespace {
+
+/// NRMSE accumulator over a window of sample indices [k0, k1].
+struct Score {
+  std::size_t k0 = 0, k1 = 0;
+  double sum_sq = 0.0, max_abs = 0.0;
+  std::size_t n = 0;
+  void add(std::size_t k, double y, double ysim) noexcept {
+    if (k < k0 || k > k1) return;
+    const double e = y - ysim;
+    sum_sq += std::isfinite(e) ? e * e : std::numeric_limits<double>::infinity();
+    max_abs = std::max(max_abs, std::fabs(y));
+    ++n;
+  }
+  double nrmse() const noexcept {
+    if (n == 0 || max_abs == 0.0) return kNaN;
+    return std::sqrt(sum_sq / static_cast<double>(n)) / max_abs;
+  }
+};
+
+/// Range of v(k−1) over the samples on which each side's RLS updated (excitation check).
+struct Excitation {
+  PerSide<double> vmin = PerSide<double>::both(std::numeric_limits<double>::infinity());
+  PerSide<double> vmax = PerSide<double>::both(-std::numeric_limits<double>::infinity());
+  PerSide<std::uint64_t> last{};
+  template <class Est>
+  void observe(const Est& est, double v_prev) noexcept {
+    for (Side s : {Side::right, Side::left}) {
+      const auto u = est.updates(s);
+      if (u != last[s]) {
+        vmin[s] = std::min(vmin[s], v_prev);
+        vmax[s] = std::max(vmax[s], v_prev);
+        last[s] = u;
+      }
+    }
+  }
+  bool exciting(Side s) const noexcept {
+    const double span = vmax[s] - vmin[s];
+    return span > 1e-9 * std::max(1.0, std::max(std::fabs(vmax[s]), std::fabs(vmin[s])));
+  }
+};
+
+SignalSpec signal_of(const Campaign& c, const RunSpec& r) {
+  SignalSpec s;
+  s.kind = r.waveform;
+  s.amplitude = r.amplitude;
+  s.frequency_rad_s = r.frequency_rad_s;
+  s.variance = c.random_variance;
+  s.tau_s = c.random_tau_s;
+  s.seed = r.seed ^ 0x5bd1e9955bd1e995ULL;  // input stream independent of the rig's noise stream
+  return s;
+}
+
+std::size_t index_at(double t_s, double dt_s) { return static_cast<std::size_t>(std::llround(t_s / dt_s)); }
+
+template <class Est>
+void fill_sides(RunResult& out, const Est& est, const Excitation& ex, double dt_s, bool check_excitation) {
+  for (Side s : {Side::right, Side::left}) {
+    const SideParams p = est.params(s);
+    SideResult& r = out.side[s];
+    r.updates = est.updates(s);
+    r.a1 = p.a1;
+    r.b1 = p.b1;
+    r.c = p.c;
+    r.identified = p.identified && std::isfinite(p.a1) && std::isfinite(p.b1) && std::isfinite(p.c);
+    if (std::isfinite(p.a1) && std::isfinite(p.b1)) {
+      r.gain = p.b1 / (1.0 + p.a1);
+      r.tau_s = (p.a1 < 0.0 && p.a1 > -1.0) ? -dt_s / std::log(-p.a1) : kNaN;
+    }
+    if (r.identified && check_excitation && !ex.exciting(s)) {
+      r.identified = false;
+      r.rejected = "input not exciting";
+    }
+  }
+  // Physical sense (thesis §1.6.1): a deadzone from Coulomb friction, spring pretension or spool
+  // overlap contains zero: c_l ≤ 0 ≤ c_r. A side that violates it is not presented as identified.
+  SideResult& R = out.side.right;
+  SideResult& L = out.side.left;
+  if (R.identified && R.c < 0.0) {
+    R.identified = false;
+    R.rejected = "unphysical deadzone";
+  }
+  if (L.identified && L.c > 0.0) {
+    L.identified = false;
+    L.rejected = "unphysical deadzone";
+  }
+  if (R.identified && L.identified && L.c > R.c) {
+    R.identified = L.identified = false;
+    R.rejected = L.rejected = "unphysical deadzone";
+  }
+}
+
+double rel_err(double est, double truth) {
+  if (!std::isfinite(est) || !std::isfinite(truth) || truth == 0.0) return std::numeric_limits<double>::infinity();
+  return std::fabs(est / truth - 1.0);
+}
+
+void score_params(RunResult& out, bool compare_tau) {
+  double worst = -1.0;
+  for (Side s : {Side::right, Side::left}) {
+    const SideResult& r = out.side[s];
+    if (!r.identified) continue;
+    const auto& t = out.truth.side[s];
+    worst = std::max(worst, rel_err(r.gain, t.gain));
+    worst = std::max(worst, rel_err(r.c, t.c));
+    if (compare_tau) worst = std::max(worst, rel_err(r.tau_s, t.tau_s));
+  }
+  if (out.d_identified) worst = std::max(worst, rel_err(out.d, out.truth.d));
+  out.param_error = worst < 0.0 ? kNaN : worst;
+}
+
+/// The common loop: v(k) from the signal, the estimator sees (v(k), y(k)) and gives y_sim(k),
+/// then the rig advances over [t_k, t_{k+1}] with v(k) held and returns y(k+1).
+template <class Est, class Rig, class Measure, class Simulated>
+void drive(Est& est, Rig& rig, Measure measure, Simulated simulated, Signal& sig, std::size_t n, Score& score,
+           Excitation& ex) {
+  auto y = rig.initial_output();
+  double v_prev = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double v = sig.next();
+    const auto [y_est, y_scored] = measure(y);
+    est.step(v, y_est);
+    ex.observe(est, v_prev);
+    score.add(k, y_scored, simulated(est));
+    v_prev = v;
+    y = rig.step(v);
+  }
+}
+
+struct SimOut {
+  template <class Est>
+  double operator()(const Est& e) const noexcept { return e.simulated(); }
+};
+
+template <class Est>
+RunResult finish(const Campaign& c, const RunSpec& r, const Est& est, const Score& score, const Excitation& ex,
+                 bool check_excitation) {
+  RunResult out;
+  out.spec = r;
+  out.nrmse = score.nrmse();
+  out.max_abs_y = score.max_abs;
+  fill_sides(out, est, ex, c.dt_s, check_excitation);
+  return out;
+}
+
+}  // namespace
+
+RunResult run_one(const Campaign& c, const RunSpec& r) {
+  Signal sig(signal_of(c, r), c.dt_s);
+  const std::size_t n = sample_count(c.duration_s, c.dt_s);
+  Score score;
+  score.k0 = index_at(c.window_start_s, c.dt_s);
+  score.k1 = std::min(n - 1, index_at(c.window_end_s, c.dt_s));
+  Excitation ex;
+  const EstimatorConfig& ec = c.estimator;
+  RunResult out;
+  switch (c.rig.kind) {
+    case rigs::RigKind::motor_cart: {
+      rigs::MotorCart rig(c.rig.motor_cart, c.dt_s, r.seed);
+      auto same = [](double y) { return std::pair<double, double>{y, y}; };
+      if (ec.model == ModelKind::input_deadzone) {
+        InputDeadzoneEstimator est(ec);
+        drive(est, rig, same, SimOut{}, sig, n, score, ex);
+        out = finish(c, r, est, score, ex, true);
+      } else {
+        OutputDeadzoneEstimator est(ec);
+        drive(est, rig, same, SimOut{}, sig, n, score, ex);
+        out = finish(c, r, est, score, ex, false);
+      }
+      out.truth = rig.effective();
+      score_params(out, true);
+      break;
+    }
+    case rigs::RigKind::pilot_valve: {
+      rigs::PilotValveRig rig(c.rig.pilot_valve, c.dt_s, r.seed);
+      auto same = [](double y) { return std::pair<double, double>{y, y}; };
+      if (ec.model == ModelKind::output_deadzone) {
+        OutputDeadzoneEstimator est(ec);
+        drive(est, rig, same, SimOut{}, sig, n, score, ex);
+        out = finish(c, r, est, score, ex, false);
+      } else {
+        InputDeadzoneEstimator est(ec);
+        drive(est, rig, same, SimOut{}, sig, n, score, ex);
+        out = finish(c, r, est, score, ex, true);
+      }
+      out.truth = c.rig.pilot_valve.effective(c.dt_s, 0.0);
+      score_params(out, false);
+      break;
+    }
+    case rigs::RigKind::coupled_carts: {
+      rigs::CoupledCarts rig(c.rig.coupled_carts, c.dt_s, r.seed);
+      // The estimator sees the free cart's position; the score is on its velocity.
+      auto pos_vel = [](const rigs::CoupledCartsSample& s) { return std::pair<double, double>{s.position_m, s.velocity_m_s}; };
+      // The model's free-cart velocity: backward difference of its simulated position (eq. 41).
+      double last_pos = 0.0;
+      const double inv_dt = 1.0 / c.dt_s;
+      auto sim_vel = [&last_pos, inv_dt](const CoupledCartsEstimator& e) {
+        const double p = e.simulated();
+        const double vel = (p - last_pos) * inv_dt;
+        last_pos = p;
+        return vel;
+      };
+      CoupledCartsEstimator est(ec);
+      drive(est, rig, pos_vel, sim_vel, sig, n, score, ex);
+      out = finish(c, r, est, score, ex, false);
+      out.d = est.deadband();
+      out.d_identified = std::isfinite(out.d) && out.d >= 0.0;
+      out.truth = rig.effective();
+      score_params(out, true);
+      break;
+    }
+  }
+  return out;
+}
+
+std::vector<RunResult> run_campaign(const Campaign& c, unsigned jobs, const ProgressFn& progress) {
+  const std::size_t total = c.runs.size();
+  std::vector<RunResult> results(total);
+  if (jobs == 0) jobs = std::max(1u, std::thread::hardware_concurrency());
+  jobs = static_cast<unsigned>(std::min<std::size_t>(jobs, std::max<std::size_t>(total, 1)));
+  std::atomic<std::size_t> next{0}, done{0};
+  std::exception_ptr first_error;
+  std::mutex mu;
+  std::condition_variable cv;
+  auto worker = [&] {
+    for (;;) {
+      const std::size_t i = next.fetch_add(1);
+      if (i >= total) break;
+      try {
+        results[i] = run_one(c, c.runs[i]);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(mu);
+        if (!first_error) first_error = std::current_exception();
+        next.store(total);
+      }
+      done.fetch_add(1);
+      cv.notify_one();
+    }
+  };
+  std::vector<std::thread> pool;
+  pool.reserve(jobs);
+  for (unsigned j = 0; j < jobs; ++j) pool.emplace_back(worker);
+  if (progress) {
+    std::unique_lock<std::mutex> lock(mu);
+    std::size_t shown = static_cast<std::size_t>(-1);
+    while (done.load() < total && !first_error) {
+      cv.wait_for(lock, std::chrono::milliseconds(200));
+      const std::size_t d = done.load();
+      if (d != shown) {
+        lock.unlock();
+        progress(d, total);
+        lock.lock();
+        shown = d;
+      }
+    }
+  }
+  for (auto& t : pool) t.join();
+  if (first_error) std::rethrow_exception(first_error);
+  if (progress) progress(total, total);
+  return results;
+}
+
+}  // namespace lash::sweep
