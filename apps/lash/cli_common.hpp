@@ -30,6 +30,7 @@ Command add_demo(CLI::App& app);
 Command add_closed_loop(CLI::App& app);
 Command add_tune(CLI::App& app);
 Command add_identify_steps(CLI::App& app);
+Command add_estimate(CLI::App& app);
 Command add_sweep(CLI::App& app);
 Command add_can(CLI::App& app);
 Command add_hil(CLI::App& app);

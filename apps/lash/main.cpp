@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
       add_closed_loop(app),
       add_tune(app),
       add_identify_steps(app),
+      add_estimate(app),
       add_sweep(app),
       add_can(app),
       add_hil(app),
