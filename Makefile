@@ -24,7 +24,7 @@ build: deps configure
 # cross-compiler determinism test (same seed -> byte-identical CSV).
 build-clang: deps
 	@test -f $(BUILD_CLANG)/build.ninja || cmake -S . -B $(BUILD_CLANG) -G Ninja -DCMAKE_BUILD_TYPE=Release \
-	  -DCMAKE_CXX_COMPILER=clang++ -DLASH_BUILD_BENCH=OFF $(CMAKE_FLAGS)
+	  -DCMAKE_CXX_COMPILER=clang++ -DLASH_BUILD_BENCH=OFF -DLASH_BUILD_FUZZ=ON $(CMAKE_FLAGS)
 	cmake --build $(BUILD_CLANG) -j $(JOBS)
 
 demo: build

@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -632,6 +633,18 @@ int run_run(const RunOptions& o) {
   out["max_abs_diff_vs_simulation_mA"] = diff.max_abs_diff_mA;
   out["compared_steps"] = diff.compared;
   if (diff.first_diff_step) out["first_diff_control_step"] = *diff.first_diff_step;
+  // Steps that consumed another frame than the one meant for them (master step m ← slave step m,
+  // slave step s ← master step s − 1): late frames, lost frames or a node running late.
+  std::set<std::int64_t> off;
+  for (std::size_t i = 0; i < m_of.size(); ++i)
+    if (m_of[i] >= 0 && (mt["sensor_fresh"][i] == 0 || static_cast<std::int64_t>(mt["sensor_counter"][i]) != m_of[i]))
+      off.insert(m_of[i]);
+  for (std::size_t i = 0; i < st.rows(); ++i) {
+    const auto sstep = static_cast<std::int64_t>(st["step"][i]);
+    if (sstep > 0 && sstep < M && (st["command_fresh"][i] == 0 || static_cast<std::int64_t>(st["command_counter"][i]) != sstep - 1))
+      off.insert(sstep);
+  }
+  out["off_schedule_steps"] = off.size();
   out["out_dir"] = dir;
   write_json(dir + "/report.json", out);
 
@@ -662,8 +675,8 @@ int run_run(const RunOptions& o) {
                  sm->settling_s, sm->overshoot_pct, sm_meas->rise_s, sm_meas->settling_s, sm_meas->overshoot_pct);
     else
       fmt::print("step response: no reference step held >= 0.5 s in this run\n");
-    fmt::print("max |emulation - simulation|: {} kPa, {} mA over {} steps\n", format_double(diff.max_abs_diff_kPa),
-               format_double(diff.max_abs_diff_mA), diff.compared);
+    fmt::print("max |emulation - simulation|: {} kPa, {} mA over {} steps ({} steps used an off-schedule frame)\n",
+               format_double(diff.max_abs_diff_kPa), format_double(diff.max_abs_diff_mA), diff.compared, off.size());
     fmt::print("logs in {}/ (master.csv, master.events.csv, master_bus.log, slave.csv, *.json, report.json)\n", dir);
   }
   return kExitOk;

@@ -180,6 +180,8 @@ double SignalCodec::to_physical(std::uint64_t raw) const noexcept {
       if (signed_) {
         const int sh = 64 - static_cast<int>(length_);
         v = static_cast<double>(static_cast<std::int64_t>(raw << sh) >> sh);
+      } else if (length_ < 64) {
+        v = static_cast<double>(static_cast<std::int64_t>(raw));  // cheaper than uint64 -> double
       } else {
         v = static_cast<double>(raw);
       }
@@ -210,7 +212,7 @@ std::uint64_t SignalCodec::to_raw(double physical, bool& clamped) const noexcept
     return std::bit_cast<std::uint32_t>(f);
   }
   if (type_ == dbc::ValueType::float64) return std::bit_cast<std::uint64_t>(scaled);
-  const double r = std::nearbyint(scaled);  // round to nearest, ties to even
+  const double r = round_half_even(scaled);  // round to nearest, ties to even
   if (r < raw_lo_) {
     clamped = true;
     return signed_ ? (std::uint64_t{1} << (length_ - 1)) & mask_ : 0;  // most negative
@@ -219,7 +221,7 @@ std::uint64_t SignalCodec::to_raw(double physical, bool& clamped) const noexcept
     clamped = true;
     return signed_ ? mask_ >> 1 : mask_;
   }
-  if (signed_) return static_cast<std::uint64_t>(static_cast<std::int64_t>(r)) & mask_;
+  if (signed_ || length_ < 64) return static_cast<std::uint64_t>(static_cast<std::int64_t>(r)) & mask_;
   return static_cast<std::uint64_t>(r);
 }
 
@@ -238,6 +240,30 @@ MessageCodec::MessageCodec(const dbc::Message& message) : message_(message) {
       mux_index_ = i;
     }
   }
+  packed_ = message.size <= 8;
+  for (std::size_t i = 0; i < codecs_.size() && packed_; ++i) {
+    const auto& s = message.signals[i];
+    const SignalCodec& c = codecs_[i];
+    Lane l{};
+    l.mask = c.mask_;
+    l.factor = c.factor_;
+    l.inv_factor = 1.0 / c.factor_;
+    l.offset = c.offset_;
+    l.min_phys = c.min_phys_;
+    l.max_phys = c.max_phys_;
+    l.raw_lo = c.raw_lo_;
+    l.raw_hi_excl = c.raw_hi_excl_;
+    l.lo = static_cast<std::uint8_t>(c.lo_base_);  // window at byte 0
+    l.sext = static_cast<std::uint8_t>(64 - c.length_);
+    l.motorola = s.byte_order == dbc::ByteOrder::motorola;
+    l.is_signed = c.signed_;
+    l.has_range = c.has_range_;
+    l.multiplexed = s.mux == dbc::MuxRole::multiplexed;
+    l.integer = s.value_type == dbc::ValueType::integer;
+    l.full64 = c.length_ == 64;
+    l.mux_value = s.mux_value;
+    lanes_.push_back(l);
+  }
   for (std::size_t i = 0; i < multiplexed_.size(); ++i)
     if (multiplexed_[i] && !has_mux_)
       throw std::invalid_argument(fmt::format("message '{}': signal '{}' is multiplexed but there is no multiplexor",
@@ -250,8 +276,53 @@ std::optional<std::size_t> MessageCodec::index_of(std::string_view signal_name) 
   return std::nullopt;
 }
 
+namespace {
+inline std::uint64_t load_le(std::span<const std::uint8_t> data, std::size_t size) noexcept {
+  std::uint64_t w = 0;
+  if (data.size() >= 8) {
+    std::memcpy(&w, data.data(), 8);
+    if constexpr (std::endian::native == std::endian::big) w = __builtin_bswap64(w);
+  } else {
+    for (std::size_t i = 0; i < size; ++i) w |= static_cast<std::uint64_t>(data[i]) << (8 * i);
+  }
+  return w;
+}
+}  // namespace
+
 bool MessageCodec::decode(std::span<const std::uint8_t> data, std::span<double> values) const noexcept {
   if (values.size() != codecs_.size() || data.size() < message_.size) return false;
+  if (packed_) {
+    const std::uint64_t le = load_le(data, message_.size);
+    const std::uint64_t be = __builtin_bswap64(le);
+    std::uint64_t mux = 0;
+    if (has_mux_) {
+      const Lane& m = lanes_[mux_index_];
+      mux = ((m.motorola ? be : le) >> m.lo) & m.mask;
+    }
+    const std::size_t n = lanes_.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const Lane& l = lanes_[i];
+      if (l.multiplexed && l.mux_value != mux) {
+        values[i] = std::numeric_limits<double>::quiet_NaN();
+        continue;
+      }
+      const std::uint64_t raw = ((l.motorola ? be : le) >> l.lo) & l.mask;
+      if (!l.integer) {
+        values[i] = codecs_[i].to_physical(raw);
+        continue;
+      }
+      double v;
+      if (l.is_signed) {
+        v = static_cast<double>(static_cast<std::int64_t>(raw << l.sext) >> l.sext);
+      } else if (!l.full64) {
+        v = static_cast<double>(static_cast<std::int64_t>(raw));
+      } else {
+        v = static_cast<double>(raw);
+      }
+      values[i] = v * l.factor + l.offset;
+    }
+    return true;
+  }
   std::uint64_t mux = 0;
   if (has_mux_) mux = *codecs_[mux_index_].read_raw(data);
   for (std::size_t i = 0; i < codecs_.size(); ++i) {
@@ -271,6 +342,74 @@ MessageCodec::EncodeResult MessageCodec::encode(std::span<const double> values, 
   if (has_mux_) {
     bool ignored = false;
     mux = codecs_[mux_index_].to_raw(values[mux_index_], ignored);
+  }
+  if (packed_) {
+    // Bits to clear/set, kept per byte order and merged into one word at the end.
+    std::uint64_t clear_le = 0, set_le = 0, clear_be = 0, set_be = 0;
+    const std::size_t n = lanes_.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const Lane& l = lanes_[i];
+      const double p0 = values[i];
+      if (l.multiplexed && (l.mux_value != mux || std::isnan(p0))) continue;
+      std::uint64_t raw;
+      bool clamped = false;
+      if (!l.integer) {
+        raw = codecs_[i].to_raw(p0, clamped);
+      } else if (std::isnan(p0)) {
+        raw = 0;
+        clamped = true;
+      } else {
+        double p = p0;
+        if (l.has_range) {
+          if (p < l.min_phys) {
+            p = l.min_phys;
+            clamped = true;
+          } else if (p > l.max_phys) {
+            p = l.max_phys;
+            clamped = true;
+          }
+        }
+        // Multiply by 1/factor; where that could round differently from the exact quotient
+        // (within ~1e-12 relative of a .5 tie, or beyond 2^51) divide instead, so the result
+        // is always round_half_even((p - offset) / factor).
+        const double q = (p - l.offset) * l.inv_factor;
+        double r = round_half_even(q);
+        const double aq = q < 0 ? -q : q;
+        const double d = q - r;
+        if (aq >= 2251799813685248.0 || (d < 0 ? -d : d) >= 0.5 - (aq + 1.0) * 1e-12)
+          r = round_half_even((p - l.offset) / l.factor);
+        if (r < l.raw_lo) {
+          clamped = true;
+          raw = l.is_signed ? (l.mask >> 1) + 1 : 0;  // most negative
+        } else if (r >= l.raw_hi_excl) {
+          clamped = true;
+          raw = l.is_signed ? l.mask >> 1 : l.mask;
+        } else if (l.full64 && !l.is_signed) {
+          raw = static_cast<std::uint64_t>(r);
+        } else {
+          raw = static_cast<std::uint64_t>(static_cast<std::int64_t>(r)) & l.mask;
+        }
+      }
+      res.clamped += clamped ? 1u : 0u;
+      if (l.motorola) {
+        clear_be |= l.mask << l.lo;
+        set_be |= raw << l.lo;
+      } else {
+        clear_le |= l.mask << l.lo;
+        set_le |= raw << l.lo;
+      }
+    }
+    std::uint64_t w = load_le(data, message_.size);
+    w = (w & ~(clear_le | __builtin_bswap64(clear_be))) | set_le | __builtin_bswap64(set_be);
+    if (data.size() >= 8) {
+      if constexpr (std::endian::native == std::endian::big) w = __builtin_bswap64(w);
+      std::memcpy(data.data(), &w, 8);
+    } else {
+      for (std::size_t i = 0; i < message_.size; ++i) data[i] = static_cast<std::uint8_t>(w >> (8 * i));
+    }
+    clamp_count_ += res.clamped;
+    res.ok = true;
+    return res;
   }
   for (std::size_t i = 0; i < codecs_.size(); ++i) {
     if (multiplexed_[i] && (mux_values_[i] != mux || std::isnan(values[i]))) continue;

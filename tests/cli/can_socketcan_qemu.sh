@@ -31,8 +31,14 @@ BUSYBOX=/bin/busybox  # busybox-static
 # 1. The kernel: Debian's current linux-image-*-amd64 (cached .deb).
 deb=$(ls linux-image-*-amd64_*.deb 2>/dev/null | head -n1 || true)
 if [[ -z "$deb" ]]; then
-  pkg=$(apt-cache depends linux-image-amd64 2>/dev/null | awk '/Depends: linux-image-/{print $2; exit}')
-  [[ -n "$pkg" ]] || die "cannot resolve linux-image-amd64 with apt-cache (apt-get update needed?)"
+  resolve() { apt-cache depends linux-image-amd64 2>/dev/null | awk '/Depends: linux-image-/{print $2; exit}'; }
+  pkg=$(resolve)
+  if [[ -z "$pkg" ]]; then  # empty apt lists (fresh CI image): refresh them once
+    SUDO=""; [[ $(id -u) -ne 0 ]] && SUDO="sudo"
+    $SUDO apt-get update -qq >/dev/null 2>&1 || true
+    pkg=$(resolve)
+  fi
+  [[ -n "$pkg" ]] || die "cannot resolve linux-image-amd64 with apt-cache (apt-get update failed?)"
   apt-get download "$pkg" >/dev/null 2>apt.err || { cat apt.err >&2; die "apt-get download $pkg failed"; }
   deb=$(ls linux-image-*-amd64_*.deb | head -n1)
 fi

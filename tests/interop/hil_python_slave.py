@@ -52,6 +52,10 @@ stats = {"dto": 0, "sensors": 0, "commands": 0}
 
 
 def slave():
+    try:  # a real-time slave where permitted (root): python's sleep jitter would look like lost frames
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(40))
+    except (PermissionError, OSError):
+        pass
     bus = can.Bus(interface="udp_multicast", channel="239.74.163.2", port=43113, receive_own_messages=False)
     plant = Plant()
     current = 0.0
@@ -96,7 +100,7 @@ th = threading.Thread(target=slave, daemon=True)
 th.start()
 time.sleep(0.5)
 out = tempfile.mkdtemp(prefix="lash_hil_py_")
-r = subprocess.run([hil_netns.lash(), "hil", "master", "--bus", "udp:239.74.163.2:43113", "--duration", "3",
+r = subprocess.run([hil_netns.lash(), "hil", "master", "--bus", "udp:239.74.163.2:43113", "--duration", "3", "--fifo", "50",
                     "--reference", "step:from=500,to=1500,time=1", "--log", f"{out}/master.csv",
                     "--stats", f"{out}/master.json", "--bus-log", f"{out}/master_bus.log"],
                    capture_output=True, text=True, timeout=60)

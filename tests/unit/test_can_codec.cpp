@@ -230,3 +230,58 @@ TEST(CanCodec, ConstructionRejectsBadLayouts) {
   m.signals = {make(8, 8, ByteOrder::intel, false)};
   EXPECT_THROW(MessageCodec{m}, std::invalid_argument);
 }
+
+TEST(CanCodec, MessagePathMatchesSignalPath) {
+  // MessageCodec's one-word path (messages <= 8 bytes) against SignalCodec one signal at a
+  // time, on random messages of non-overlapping signals and random (also out-of-range) values.
+  lash::Rng rng(99);
+  const double factors[] = {0.1, 0.5, 1.0, 2.5, 0.01, -0.25, 1e-3};
+  for (int n = 0; n < 20000; ++n) {
+    dbc::Message m;
+    m.name = "R";
+    m.size = static_cast<std::uint32_t>(1 + rng.next() % 8);
+    std::vector<bool> used(64, false);
+    const int want = 1 + static_cast<int>(rng.next() % 6);
+    for (int k = 0; k < want * 4 && static_cast<int>(m.signals.size()) < want; ++k) {
+      const auto len = static_cast<std::uint32_t>(1 + rng.next() % std::min<std::uint32_t>(64, m.size * 8));
+      auto s = make(static_cast<std::uint32_t>(rng.next() % (m.size * 8)), len,
+                    (rng.next() & 1) ? ByteOrder::intel : ByteOrder::motorola, (rng.next() & 1) != 0,
+                    factors[rng.next() % 7], static_cast<double>(static_cast<int>(rng.next() % 200) - 100));
+      if (rng.next() % 3 == 0) {
+        s.minimum = -50;
+        s.maximum = 50;
+      }
+      if (s.byte_order == ByteOrder::intel && s.start_bit + len > m.size * 8) continue;
+      if (naive_min_bytes(s) > m.size) continue;
+      const auto pos = naive_positions(s);
+      bool clash = false;
+      for (auto p : pos) clash = clash || used[p];
+      if (clash) continue;
+      for (auto p : pos) used[p] = true;
+      s.name = "s" + std::to_string(m.signals.size());
+      m.signals.push_back(s);
+    }
+    MessageCodec mc(m);
+    ASSERT_TRUE(mc.packed());
+    std::vector<SignalCodec> sc;
+    for (const auto& s : m.signals) sc.emplace_back(s);
+    std::vector<double> vals(m.signals.size());
+    for (auto& v : vals) {
+      const double u = static_cast<double>(rng.next() % 2000001) / 1000.0 - 1000.0;  // -1000..1000, step 0.001
+      v = (rng.next() % 5 == 0) ? std::round(u) + 0.5 : u;  // some exact ties
+    }
+    std::vector<std::uint8_t> a(8), b(8);
+    for (std::size_t i = 0; i < 8; ++i) a[i] = b[i] = static_cast<std::uint8_t>(rng.next());
+    const std::size_t span = (rng.next() & 1) ? 8 : m.size;
+    const auto r = mc.encode(vals, {a.data(), span});
+    ASSERT_TRUE(r.ok);
+    std::uint32_t clamps = 0;
+    for (std::size_t i = 0; i < sc.size(); ++i)
+      clamps += sc[i].encode(vals[i], {b.data(), span}) == SignalCodec::Status::clamped ? 1u : 0u;
+    ASSERT_EQ(a, b) << "message " << n;
+    ASSERT_EQ(r.clamped, clamps);
+    std::vector<double> out(vals.size());
+    ASSERT_TRUE(mc.decode({a.data(), span}, out));
+    for (std::size_t i = 0; i < sc.size(); ++i) ASSERT_EQ(out[i], *sc[i].decode({a.data(), span})) << n;
+  }
+}

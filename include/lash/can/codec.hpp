@@ -24,6 +24,16 @@
 
 namespace lash::can {
 
+/// Round to nearest, ties to even, without libm (std::nearbyint is a library call on
+/// baseline x86-64). Exact for every double: values with |x| ≥ 2^52 are integers already.
+inline double round_half_even(double x) noexcept {
+  constexpr double k2p52 = 4503599627370496.0;
+  const double a = x < 0 ? -x : x;
+  if (!(a < k2p52)) return x;  // also NaN
+  const double r = (a + k2p52) - k2p52;
+  return x < 0 ? -r : r;
+}
+
 class SignalCodec {
  public:
   /// Throws std::invalid_argument for a layout that cannot be coded (length 0/>64,
@@ -73,6 +83,7 @@ class SignalCodec {
   std::uint64_t clamp_count() const noexcept { return clamp_count_; }
 
  private:
+  friend class MessageCodec;
   using ReadFn = std::uint64_t (*)(const SignalCodec&, const std::uint8_t*, std::size_t) noexcept;
   using WriteFn = void (*)(const SignalCodec&, std::uint8_t*, std::size_t, std::uint64_t) noexcept;
   template <bool Motorola>
@@ -132,8 +143,23 @@ class MessageCodec {
   EncodeResult encode(std::span<const double> values, std::span<std::uint8_t> data) noexcept;
   /// Clamps counted over this codec's lifetime.
   std::uint64_t clamp_count() const noexcept { return clamp_count_; }
+  /// True when the message fits 8 bytes and uses the one-word path (see codec.cpp).
+  bool packed() const noexcept { return packed_; }
 
  private:
+  /// Per-signal constants of the one-word path for messages of at most 8 bytes: the
+  /// payload is loaded once as a little-endian and a big-endian 64-bit word and every
+  /// signal is a shift and a mask of one of them.
+  struct Lane {
+    std::uint64_t mask;
+    double factor, inv_factor, offset, min_phys, max_phys, raw_lo, raw_hi_excl;
+    std::uint8_t lo;       ///< LSB position in the word
+    std::uint8_t sext;     ///< 64 - length (sign extension shift)
+    bool motorola, is_signed, has_range, multiplexed, integer, full64;
+    std::uint64_t mux_value;
+  };
+  std::vector<Lane> lanes_;
+  bool packed_ = false;
   dbc::Message message_;
   std::vector<SignalCodec> codecs_;
   std::vector<std::uint64_t> mux_values_;  ///< per signal; meaningful when multiplexed

@@ -1,0 +1,159 @@
+// HIL node step functions (what the master's TET measures, minus the bus's system calls)
+// and the UDP bus's send/receive cost, to split `lash hil run`'s TET into compute and I/O.
+#include <benchmark/benchmark.h>
+
+#include <sched.h>
+
+#include <memory>
+
+#include "lash/can/bus.hpp"
+#include "lash/hil/nodes.hpp"
+#include "lash/hil/netns.hpp"
+
+namespace {
+
+using namespace lash;
+using namespace lash::hil;
+
+/// A bus that hands out one prepared frame per receive cycle and drops what is sent:
+/// no system calls, no allocation — isolates a node's own work.
+class ScriptedBus final : public can::Bus {
+ public:
+  can::Frame next;
+  bool pending = false;
+  bool send(const can::Frame& f) noexcept override {
+    last_sent = f;
+    return true;
+  }
+  std::optional<can::Frame> receive(std::chrono::nanoseconds) noexcept override {
+    if (!pending) return std::nullopt;
+    pending = false;
+    return next;
+  }
+  void set_filters(std::vector<can::Filter>) override {}
+  can::BusStats stats() const noexcept override { return {}; }
+  std::string address() const override { return "scripted"; }
+  can::Frame last_sent;
+};
+
+can::Frame dto() {
+  can::Frame f;
+  f.id = 0x7E1;
+  f.len = 8;
+  f.data[0] = 0xFF;
+  return f;
+}
+
+MasterConfig master_cfg() {
+  MasterConfig m;
+  m.controller.pid.dt_s = 0.005;
+  m.controller.pid.gains = {1.2, 12.0, 0.004, 0.0};
+  m.reference.kind = Waveform::square;
+  m.reference.amplitude = 500;
+  m.reference.offset = 1000;
+  m.reference.frequency_rad_s = 3.0;
+  m.log_capacity = 1 << 16;
+  return m;
+}
+
+void BM_HilMasterStep(benchmark::State& state) {
+  BenchLayout L;
+  MasterNode master(L, master_cfg());
+  ScriptedBus bus;
+  master.step(bus, 0.0);  // CRO
+  bus.next = dto();
+  bus.pending = true;
+  master.step(bus, 0.0);  // connected
+  std::uint16_t c = 0;
+  for (auto _ : state) {
+    bus.next = L.pack_sensors({static_cast<std::uint16_t>(17000 + (c & 255)), 0, c});
+    bus.pending = true;
+    ++c;
+    benchmark::DoNotOptimize(master.step(bus, 0.0));
+  }
+  state.SetLabel("master step without bus I/O: drain, decode, PID + DZ inverse + saturation, encode, log");
+}
+BENCHMARK(BM_HilMasterStep);
+
+void BM_HilSlaveStep(benchmark::State& state) {
+  BenchLayout L;
+  SlaveConfig sc;
+  sc.dto_reply = {dto()};
+  sc.log_capacity = 1 << 16;
+  SlaveNode slave(L, sc);
+  ScriptedBus bus;
+  std::uint16_t c = 0;
+  for (auto _ : state) {
+    bus.next = L.pack_command({800.0 + (c & 255), 0, 0, c});
+    bus.pending = true;
+    ++c;
+    slave.step(bus, 0.0);
+  }
+  state.SetLabel("slave step without bus I/O: drain, decode, plant (noise, sensor code), encode, log");
+}
+BENCHMARK(BM_HilSlaveStep);
+
+// The UDP multicast bus (python-can wire format) inside a private network namespace:
+// one frame sent by one endpoint and received by another, and a receive on an empty queue.
+bool in_private_netns() {
+  static const bool ok = enter_private_netns().ok;
+  return ok;
+}
+
+void BM_UdpSendReceive(benchmark::State& state) {
+  if (!in_private_netns()) {
+    state.SkipWithError("no private network namespace (needs root or user namespaces)");
+    return;
+  }
+  auto a = can::open_bus("udp:239.74.163.2:43113");
+  auto b = can::open_bus("udp:239.74.163.2:43113");
+  BenchLayout L;
+  const can::Frame f = L.pack_sensors({17000, 0, 1});
+  for (auto _ : state) {
+    a->send(f);
+    std::optional<can::Frame> g;
+    while (!(g = b->receive(std::chrono::nanoseconds(0)))) {
+    }
+    benchmark::DoNotOptimize(g);
+  }
+  state.SetLabel("send + receive of one frame between two endpoints");
+}
+BENCHMARK(BM_UdpSendReceive);
+
+void BM_UdpSend(benchmark::State& state) {
+  if (!in_private_netns()) {
+    state.SkipWithError("no private network namespace");
+    return;
+  }
+  auto a = can::open_bus("udp:239.74.163.2:43113");
+  auto b = can::open_bus("udp:239.74.163.2:43113");
+  BenchLayout L;
+  const can::Frame f = L.pack_sensors({17000, 0, 1});
+  std::size_t n = 0;
+  for (auto _ : state) {
+    a->send(f);
+    if (++n % 64 == 0) {
+      state.PauseTiming();
+      while (b->receive(std::chrono::nanoseconds(0))) {
+      }
+      while (a->receive(std::chrono::nanoseconds(0))) {
+      }
+      state.ResumeTiming();
+    }
+  }
+  state.SetLabel("send only (multicast delivered to the other endpoint)");
+}
+BENCHMARK(BM_UdpSend);
+
+void BM_UdpReceiveEmpty(benchmark::State& state) {
+  if (!in_private_netns()) {
+    state.SkipWithError("no private network namespace");
+    return;
+  }
+  auto b = can::open_bus("udp:239.74.163.2:43113");
+  for (auto _ : state) benchmark::DoNotOptimize(b->receive(std::chrono::nanoseconds(0)));
+  state.SetLabel("receive(0) with nothing queued (the end of every drain)");
+}
+BENCHMARK(BM_UdpReceiveEmpty);
+
+}  // namespace

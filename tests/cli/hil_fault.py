@@ -1,0 +1,94 @@
+"""Faults (issue 6 item 7), in a private network namespace:
+- the slave is killed (SIGKILL) mid-run: the master commands 0 mA within 3 periods of the
+  last sensor frame and logs the fault with its time; the slave is restarted: the master
+  reconnects (CCP CONNECT answered again) and control resumes; the events log shows both;
+- SIGINT/SIGTERM stop both nodes at a step boundary with complete logs and exit 0."""
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+
+sys.path.insert(0, os.path.dirname(__file__))
+import hil_netns  # noqa: E402
+
+hil_netns.enter_private_netns()
+
+LASH = hil_netns.lash()
+BUS = "udp:239.74.163.2:43113"
+out = tempfile.mkdtemp(prefix="lash_hil_fault_")
+
+
+def start_slave(tag):
+    p = subprocess.Popen([LASH, "hil", "slave", "--bus", BUS, "--fifo", "40", "--duration", "30",
+                          "--log", f"{out}/slave_{tag}.csv", "--stats", f"{out}/slave_{tag}.json"],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert "ready" in p.stdout.readline()
+    return p
+
+
+s1 = start_slave("a")
+master = subprocess.Popen([LASH, "hil", "master", "--bus", BUS, "--fifo", "50", "--duration", "4",
+                           "--reference", "step:from=500,to=1500,time=0.5", "--log", f"{out}/master.csv",
+                           "--events", f"{out}/events.csv", "--stats", f"{out}/master.json"],
+                          stderr=subprocess.PIPE, text=True)
+time.sleep(1.5)
+s1.send_signal(signal.SIGKILL)
+s1.wait()
+time.sleep(0.7)
+s2 = start_slave("b")
+_, err = master.communicate(timeout=30)
+print(err)
+assert master.returncode == 0, err
+s2.send_signal(signal.SIGTERM)
+_, s2err = s2.communicate(timeout=10)
+assert s2.returncode == 0, s2err
+
+m = hil_netns.read_csv(f"{out}/master.csv")
+with open(f"{out}/events.csv") as f:
+    events = [line.strip().split(",") for line in f.readlines()[1:]]
+kinds = [e[2] for e in events]
+print(events)
+assert kinds[:2] == ["ccp_connect_sent", "ccp_connected"], kinds
+assert "sensor_timeout_safe_state" in kinds and "sensor_resumed" in kinds, kinds
+# The kill is the longest fault (a busy machine may add short ones: each is logged too).
+faults = [(int(e[0]), next(int(r[0]) for r in events[i:] if r[2] == "sensor_resumed"))
+          for i, e in enumerate(events) if e[2] == "sensor_timeout_safe_state"]
+fault_step, resume_step = max(faults, key=lambda f: f[1] - f[0])
+steps = [int(v) for v in m["step"]]
+row = {s: i for i, s in enumerate(steps)}
+# The last fresh sensor frame before the fault, then 0 mA within 3 periods.
+last_fresh = max(s for s in steps if s < fault_step and m["sensor_fresh"][row[s]] == 1)
+zero_from = min(s for s in steps if s > last_fresh and m["current_mA"][row[s]] == 0.0)
+print(f"last sensor frame at step {last_fresh}, 0 mA from step {zero_from}, fault logged at step {fault_step}, "
+      f"resumed at step {resume_step}")
+assert zero_from - last_fresh <= 3, (last_fresh, zero_from)
+assert fault_step == zero_from
+# Safe state held until the restarted slave answers; then control resumes and tracks again.
+for s in range(zero_from, resume_step):
+    assert m["current_mA"][row[s]] == 0.0 and m["state"][row[s]] == 2, s
+assert m["state"][row[resume_step]] == 1
+assert (resume_step - fault_step) * 0.005 >= 0.6  # the slave was down for 0.7 s
+tail = [m["measured_kPa"][i] for i, s in enumerate(steps) if s >= resume_step + 200]
+assert len(tail) > 50 and abs(sum(tail) / len(tail) - 1500) < 15, sum(tail) / len(tail)
+
+# SIGINT to both nodes: they stop at a step boundary, write whole logs and exit 0.
+s3 = start_slave("c")
+m2 = subprocess.Popen([LASH, "hil", "master", "--bus", BUS, "--duration", "60", "--log", f"{out}/m2.csv",
+                       "--bus-log", f"{out}/m2.log", "--stats", f"{out}/m2.json"], stderr=subprocess.PIPE, text=True)
+time.sleep(1.0)
+m2.send_signal(signal.SIGINT)
+s3.send_signal(signal.SIGINT)
+_, e2 = m2.communicate(timeout=10)
+_, e3 = s3.communicate(timeout=10)
+assert m2.returncode == 0 and s3.returncode == 0, (e2, e3)
+for path in (f"{out}/m2.csv", f"{out}/slave_c.csv", f"{out}/m2.log"):
+    text = open(path).read()
+    assert text.endswith("\n"), path
+    lines = text.splitlines()
+    width = len(lines[0].split(",")) if path.endswith(".csv") else 3
+    assert all(len(line.split(",") if path.endswith(".csv") else line.split(" ")) == width for line in lines), path
+    print(path, len(lines), "lines, complete")
+assert 100 < len(open(f"{out}/m2.csv").read().splitlines()) < 400
+print("ok")
