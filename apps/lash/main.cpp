@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   std::vector<Command> commands{
       add_simulate(app),
       add_demo(app),
+      add_estimate(app),
       add_sweep(app),
       add_can(app),
       add_hil(app),

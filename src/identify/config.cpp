@@ -62,11 +62,13 @@ void EstimatorConfig::validate() const {
   require(noise.filter_length >= 1 && noise.filter_length <= 100000, "filter-length", "must be in 1..100000");
   require(noise.derivative_filter_length >= 1 && noise.derivative_filter_length <= 100000,
           "derivative-filter-length", "must be in 1..100000");
+  require(noise.derivative_prefilter_length <= 100000, "derivative-prefilter-length", "must be in 0..100000");
   require(noise.input_delay <= 100000, "input-delay", "must be <= 100000 samples");
   require(noise.align_delay <= 100000, "align-delay", "must be <= 100000 samples");
   require(std::isfinite(noise.derivative_threshold) && noise.derivative_threshold >= 0, "derivative-threshold",
           "must be >= 0 [y unit/s]");
   require(iv_delay >= 1 && iv_delay <= 60, "iv-delay", "must be in 1..60 samples");
+  require(direction_run >= 2 && direction_run <= 1000000, "direction-run", "must be in 2..1000000 samples");
   require(min_updates >= 1, "min-updates", "must be >= 1");
   require(std::isfinite(singular_tol) && singular_tol > 0, "singular-tol", "must be > 0");
   require(std::isfinite(zero_threshold) && zero_threshold >= 0, "zero-threshold", "must be >= 0");

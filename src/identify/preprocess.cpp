@@ -4,15 +4,18 @@ namespace lash {
 
 Preprocessor::Preprocessor(const NoiseSettings& s, double dt_s)
     : identity_(s.filter_length == 1 && !s.filter_input && s.input_delay == 0 && s.derivative_filter_length == 1 &&
-                s.align_delay == 0),
+                s.align_delay == 0 && (s.derivative_prefilter_length == 0 || s.derivative_prefilter_length == 1)),
       filter_y_(s.filter_length > 1),
       filter_v_(s.filter_input && s.filter_length > 1),
       filter_d_(s.derivative_filter_length > 1),
+      separate_pre_(s.derivative_prefilter_length != 0 && s.derivative_prefilter_length != s.filter_length),
+      filter_p_(s.derivative_prefilter_length > 1),
       inv_dt_(1.0 / dt_s),
       s_(s),
       ma_y_(s.filter_length),
       ma_v_(s.filter_length),
       ma_d_(s.derivative_filter_length),
+      ma_p_(s.derivative_prefilter_length == 0 ? 1 : s.derivative_prefilter_length),
       diff_(dt_s),
       delay_v_(s.input_delay),
       align_v_(s.align_delay),
@@ -23,6 +26,7 @@ void Preprocessor::reset() noexcept {
   ma_y_.reset();
   ma_v_.reset();
   ma_d_.reset();
+  ma_p_.reset();
   diff_.reset();
   delay_v_.reset();
   align_v_.reset();

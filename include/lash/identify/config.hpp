@@ -52,6 +52,9 @@ struct NoiseSettings {
   bool filter_input = false;
   /// Pure delay of v [samples] that keeps v aligned with a filtered y when v itself is not filtered.
   std::size_t input_delay = 0;
+  /// Moving average on y before the derivative is taken [samples]; 0 = the same filter as the
+  /// regression's (filter_length). Lets the regression use raw y while switching uses a smooth ẏ.
+  std::size_t derivative_prefilter_length = 0;
   /// M-point moving average on the backward-difference derivative ẏ [samples]; 1 = off.
   std::size_t derivative_filter_length = 1;
   /// Dead band on ẏ: |ẏ| ≤ threshold counts as "not moving" [y unit/s]. 0 = sign of the difference.
@@ -73,7 +76,12 @@ struct EstimatorConfig {
   /// deadzone-deadband: one 4-parameter regression per side with a1, b1 shared between
   /// directions (η = [a1, b1, −b1·c, d(1+a1)]) instead of the thesis's separate + and − RLS.
   bool pooled = false;
-  std::uint64_t min_updates = 10;  ///< a key needs this many updates before its side is identified
+  /// deadzone-deadband: a key is updated only after the direction of motion (and the side of
+  /// v) has held for this many consecutive samples. 2 is the thesis's y(k) > y(k−1) > y(k−2);
+  /// with a moving-average filter of length M use ≥ M + 1 so the whole filter window lies in
+  /// one regime (then the filtered v and y obey the same linear relation exactly).
+  std::uint32_t direction_run = 2;
+  std::uint64_t min_updates = 50;  ///< a key needs this many updates before its side is identified
   double singular_tol = 1e-6;      ///< eq. 31/32: |det| below tol·(|a|+|b|) terms counts as singular
   double zero_threshold = 0.0;     ///< output-deadzone: |y| ≤ this counts as 0 [y unit]
   double accel_limit = std::numeric_limits<double>::infinity();  ///< coupled-carts stage 1: max |ÿ| [y unit/s²]

@@ -147,7 +147,9 @@ class DeadzoneDeadbandEstimator {
     const int dir = direction(s.ydot, cfg_.noise.derivative_threshold);
     const double y1 = y1_, v1 = v1_;
     const int side = v1 > cfg_.guess_right ? 0 : (v1 < cfg_.guess_left ? 1 : -1);
-    if (side >= 0 && dir != 0 && dir == dir1_) {
+    run_ = (dir != 0 && dir == dir1_ && side == side1_) ? run_ + 1 : 1;
+    side1_ = side;
+    if (side >= 0 && dir != 0 && run_ >= cfg_.direction_run) {
       const int key = side * 2 + (dir > 0 ? 0 : 1);
       if (cfg_.pooled) {
         const double sg = dir > 0 ? -1.0 : 1.0;
@@ -217,7 +219,8 @@ class DeadzoneDeadbandEstimator {
   std::array<double, 2> sa1_{}, sb1_{}, sc_{}, sd_{};
   detail::History hist_;
   double y1_ = 0.0, v1_ = 0.0, vraw1_ = 0.0, w_ = 0.0;
-  int dir1_ = 0, last_ = 0, sim_last_ = 0;
+  int dir1_ = 0, last_ = 0, sim_last_ = 0, side1_ = -1;
+  std::uint32_t run_ = 0;
   double yhat_ = 0.0, ysim_ = 0.0;
   std::uint64_t skipped_ = 0;
 };

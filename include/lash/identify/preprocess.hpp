@@ -2,7 +2,8 @@
 /// @file preprocess.hpp
 /// Noise handling of SPEC A5 / thesis §1.4.5, one sample at a time:
 ///   y_f = MA_M(y),  v_f = MA_M(v) (filter_input) or Delay_n(v),
-///   ẏ  = MA_M2(BackwardDifference(y_f))            (eq. 26; var(ẏ) = 2 var(y)/T², eq. 33)
+///   ẏ  = MA_M2(BackwardDifference(MA_Mp(y)))       (eq. 26; var(ẏ) = 2 var(y)/T², eq. 33)
+///        with Mp = derivative_prefilter_length (0: the regression filter M)
 ///   regression signals = Delay_align(v_f), Delay_align(y_f) so they line up with ẏ.
 /// Storage is allocated at construction; step() is noexcept, O(1), allocation-free.
 #include <cstddef>
@@ -35,7 +36,7 @@ class Preprocessor {
     const double yf = filter_y_ ? ma_y_.step(y) : y;
     double vf = filter_v_ ? ma_v_.step(v) : v;
     vf = delay_v_.step(vf);
-    double d = diff_.step(yf);
+    double d = diff_.step(separate_pre_ ? (filter_p_ ? ma_p_.step(y) : y) : yf);
     if (filter_d_) d = ma_d_.step(d);
     return {align_v_.step(vf), align_y_.step(yf), d};
   }
@@ -46,11 +47,11 @@ class Preprocessor {
 
  private:
   bool identity_;
-  bool filter_y_, filter_v_, filter_d_;
+  bool filter_y_, filter_v_, filter_d_, separate_pre_, filter_p_;
   double inv_dt_;
   double y_prev_ = 0.0;
   NoiseSettings s_;
-  MovingAverage ma_y_, ma_v_, ma_d_;
+  MovingAverage ma_y_, ma_v_, ma_d_, ma_p_;
   BackwardDifference diff_;
   Delay delay_v_, align_v_, align_y_;
 };

@@ -1,0 +1,72 @@
+#!/usr/bin/env python3
+"""lash estimate --json: exactly one JSON object of the documented shape; the trace CSV has
+t, y, yhat, y_sim and every parameter. Data: the E1 plant simulated by `lash simulate`; the
+reference values are the plant file's parameters (thesis eq. 34)."""
+import csv, json, math, os, subprocess, sys, tempfile
+
+LASH = os.environ["LASH"]
+SRC = os.environ["LASH_SOURCE_DIR"]
+fail = 0
+
+
+def check(cond, what):
+    global fail
+    print(("ok   " if cond else "FAIL ") + what)
+    if not cond:
+        fail = 1
+
+
+with tempfile.TemporaryDirectory() as d:
+    data = os.path.join(d, "e1.csv")
+    subprocess.run([LASH, "simulate", f"{SRC}/config/plants/thesis_eq34.toml", "--amplitude", "600",
+                    "--duration", "200", "-o", data], check=True, capture_output=True)
+    trace = os.path.join(d, "trace.csv")
+    out = subprocess.run([LASH, "estimate", "--model", "deadzone-deadband", "--guess-left", "-350",
+                          "--guess-right", "350", "--lambda", "0.99", "--p0", "1000", data, "--json",
+                          "-o", trace], check=True, capture_output=True, text=True).stdout
+    lines = [l for l in out.splitlines() if l.strip()]
+    check(len(lines) == 1, "stdout is one line")
+    j = json.loads(out)
+    check(list(j.keys()) == ["model", "samples", "right", "left", "nrmse", "nrmse_window_s"], f"keys {list(j)}")
+    check(j["model"] == "deadzone-deadband" and j["samples"] == 40000, "model and samples")
+    truth = {"right": dict(a1=-0.96, b1=0.1, c=200.0, d=30.0), "left": dict(a1=-0.94, b1=0.15, c=-300.0, d=50.0)}
+    for side in ("right", "left"):
+        s = j[side]
+        check(list(s.keys()) == ["a1", "b1", "c", "d", "identified", "updates"], f"{side} keys {list(s)}")
+        check(s["identified"] is True, f"{side} identified")
+        check(set(s["updates"]) == {"+", "-"} and min(s["updates"].values()) > 1000, f"{side} updates {s['updates']}")
+        for k, v in truth[side].items():
+            check(abs(s[k] - v) <= 1e-4 * abs(v), f"{side} {k} = {s[k]} vs {v}")
+    check(j["nrmse_window_s"][0] == 7.5 and abs(j["nrmse_window_s"][1] - 199.995) < 1e-9, "nrmse window")
+    check(0 <= j["nrmse"] < 0.02, f"nrmse {j['nrmse']}")
+    with open(trace) as f:
+        rows = list(csv.reader(f))
+    check(rows[0] == ["t", "y", "yhat", "y_sim", "a1_r", "b1_r", "c_r", "d_r", "a1_l", "b1_l", "c_l", "d_l"],
+          f"trace header {rows[0]}")
+    check(len(rows) == 40001, "trace rows")
+    last = dict(zip(rows[0], map(float, rows[-1])))
+    check(abs(last["d_l"] - 50) < 5e-3 and abs(last["c_r"] - 200) < 2e-2, "trace last parameters")
+    check(math.isnan(float(rows[1][4])), "not identified at t = 0 is nan in the trace")
+
+    # linear: flat keys; a model's missing keys are omitted
+    out = subprocess.run([LASH, "estimate", "--model", "linear", data, "--json"], check=True, capture_output=True,
+                         text=True).stdout
+    j = json.loads(out)
+    check(list(j.keys()) == ["model", "samples", "a1", "b1", "identified", "updates", "nrmse", "nrmse_window_s"],
+          f"linear keys {list(j)}")
+    # input-deadzone: no d; a side never excited is null + identified false
+    out = subprocess.run([LASH, "estimate", "--model", "input-deadzone", "--guess-left", "-700",
+                          "--guess-right", "350", data, "--json"], check=True, capture_output=True, text=True).stdout
+    j = json.loads(out)
+    check("d" not in j["right"] and "c" in j["right"], "input-deadzone has c, no d")
+    check(j["left"]["identified"] is False and j["left"]["c"] is None and j["left"]["a1"] is None,
+          f"left never updated -> null: {j['left']}")
+    # renamed columns + config file
+    cfg = os.path.join(d, "est.toml")
+    with open(cfg, "w") as f:
+        f.write('model = "deadzone-deadband"\nguess_left = -350.0\nguess_right = 350.0\n'
+                'columns = ["t", "v", "y_true"]\nnrmse_window = [10.0, 100.0]\n[rls]\nlambda = 0.99\n')
+    j = json.loads(subprocess.run([LASH, "estimate", "--config", cfg, data, "--json"], check=True,
+                                  capture_output=True, text=True).stdout)
+    check(j["nrmse_window_s"] == [10.0, 100.0] and abs(j["right"]["d"] - 30) < 1e-3, "config file")
+sys.exit(fail)
