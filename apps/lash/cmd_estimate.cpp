@@ -1,4 +1,5 @@
 // lash estimate: run one of the switching estimators of SPEC A4 over a recorded t,v,y file.
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <optional>
@@ -32,6 +33,7 @@ struct EstimateOptions {
   std::string out;
   std::string plot;
   bool json = false;
+  bool timing = false;
 };
 
 std::vector<std::string> split_names(const std::string& text) {
@@ -129,7 +131,12 @@ int run(const EstimateOptions& o) {
   const Record rec = load_record(o.data, job.columns);
   cfg.dt_s = rec.dt_s;
   const bool keep = !o.out.empty() || !o.plot.empty();
+  const auto t_start = std::chrono::steady_clock::now();
   const EstimationRun run = run_estimator(cfg, rec.v(), rec.y(), keep);
+  const double elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  if (o.timing)
+    fmt::print(stderr, "lash estimate: estimator ran {} samples in {} s ({:.3g} M samples/s)\n", rec.v().size(),
+               format_double(elapsed_s), static_cast<double>(rec.v().size()) / elapsed_s * 1e-6);
   const auto& t = rec.t();
   const double t1 = job.nrmse_t1_s < 0 ? t.back() : job.nrmse_t1_s;
   const double fit = nrmse(t, rec.y(), run.ysim, job.nrmse_t0_s, t1);
@@ -266,6 +273,7 @@ Command add_estimate(CLI::App& app) {
   sub->add_option("-o,--output", o->out, "Trace CSV: t, y, yhat, y_sim and every parameter per step");
   sub->add_option("--plot", o->plot, "PNG of parameter convergence and measured vs simulated output");
   sub->add_flag("--json", o->json, "Print exactly one JSON object with the result on stdout");
+  sub->add_flag("--timing", o->timing, "Print the estimator's own run time (without file I/O) on stderr");
   // a later option overrides an earlier one (handy for wrappers that append settings)
   for (auto* opt : sub->get_options())
     if (opt->get_expected_max() == 1 && opt->get_name() != "--nrmse-window")

@@ -4,7 +4,8 @@
 
 namespace lash::hil {
 
-std::optional<StepWindow> find_step(const std::vector<double>& r, double dt_s, double min_hold_s) {
+std::optional<StepWindow> find_step(const std::vector<double>& r, double dt_s, double min_hold_s,
+                                    double max_window_s) {
   std::size_t level_start = 0;
   for (std::size_t k = 1; k < r.size(); ++k) {
     if (r[k] == r[k - 1]) continue;
@@ -16,7 +17,8 @@ std::optional<StepWindow> find_step(const std::vector<double>& r, double dt_s, d
       w.y0 = r[k - 1];
       w.y1 = r[k];
       std::size_t e = k + 1;
-      while (e < r.size() && r[e] == r[k]) ++e;
+      const auto max_n = static_cast<std::size_t>(std::llround(max_window_s / dt_s));
+      while (e < r.size() && r[e] == r[k] && e - k < max_n) ++e;
       w.end = e;
       return w;
     }

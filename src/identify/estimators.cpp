@@ -208,15 +208,24 @@ void DeadzoneDeadbandEstimator::refresh(int side) noexcept {
   } else {
     const auto& ep = rls_[side * 2].eta();
     const auto& em = rls_[side * 2 + 1].eta();
-    const double n = static_cast<double>(np + nm);
-    const double wp = n > 0 ? static_cast<double>(np) / n : 0.5;
-    a1 = wp * ep[0] + (1.0 - wp) * em[0];
-    b1 = wp * ep[1] + (1.0 - wp) * em[1];
     // eq. 31/32: [−(1+a+)  −b+; (1+a−)  −b−] [d; c] = [e+; e−]
     const double t1 = (1.0 + ep[0]) * em[1], t2 = ep[1] * (1.0 + em[0]);
     const double det = t1 + t2;
     ok = ok && std::fabs(det) > cfg_.singular_tol * (std::fabs(t1) + std::fabs(t2));
-    const double inv = 1.0 / det;
+    // one division for both the count-weighted mean (1/n) and the 2×2 solve (1/det)
+    const double fp = static_cast<double>(np), fm = static_cast<double>(nm);
+    const double n = fp + fm;  // ≥ 1: this side was just updated
+    double inv, inv_n;
+    if (det != 0.0 && std::isfinite(det)) {
+      const double both = 1.0 / (n * det);
+      inv = n * both;
+      inv_n = det * both;
+    } else {  // singular: no (d, c), but the model keeps its a1, b1
+      inv = detail::kNaN;
+      inv_n = 1.0 / n;
+    }
+    a1 = (fp * ep[0] + fm * em[0]) * inv_n;
+    b1 = (fp * ep[1] + fm * em[1]) * inv_n;
     d = (-em[1] * ep[2] + ep[1] * em[2]) * inv;
     c = (-(1.0 + em[0]) * ep[2] - (1.0 + ep[0]) * em[2]) * inv;
   }

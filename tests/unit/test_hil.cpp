@@ -235,3 +235,53 @@ TEST(HilMaster, DtoTimeoutFails) {
   EXPECT_EQ(steps, 11);  // CRO at t = 0; failed at t = 0.05 s (step 10)
   EXPECT_EQ(master.events().back().kind, MasterEventKind::dto_timeout);
 }
+
+#include "lash/hil/report.hpp"
+
+TEST(HilReport, StepResponseByHand) {
+  // Rise: z crosses 0.9 between t=1 (0.5) and t=2 (1.2): 1 + 0.4/0.7. Overshoot 20 %.
+  // Settling: last out of band at t=2 (1.2), back in at t=3 (0.95): edge 1.1 crossed at 2 + 0.1/0.25.
+  const std::vector<double> t{0, 1, 2, 3, 4}, y{0, 0.5, 1.2, 0.95, 1.0};
+  const StepResponse r = step_response(t, y, 0.0, 0.0, 1.0);
+  EXPECT_NEAR(r.rise_s, 1.0 + 0.4 / 0.7, 1e-12);
+  EXPECT_NEAR(r.overshoot_pct, 20.0, 1e-9);
+  EXPECT_NEAR(r.settling_s, 2.4, 1e-12);
+  // Downward step 10 -> 0 mirrors it.
+  std::vector<double> yd;
+  for (double v : y) yd.push_back(10.0 - 10.0 * v);
+  const StepResponse d = step_response(t, yd, 0.0, 10.0, 0.0);
+  EXPECT_NEAR(d.rise_s, r.rise_s, 1e-12);
+  EXPECT_NEAR(d.overshoot_pct, 20.0, 1e-9);
+  EXPECT_NEAR(d.settling_s, 2.4, 1e-12);
+}
+
+TEST(HilReport, FirstOrderStepIsTauLn10) {
+  // y = 1 − exp(−t/τ): 90 % rise = 10 % settling = τ ln 10, no overshoot.
+  const double tau = 0.1, dt = 1e-4;
+  std::vector<double> t, y;
+  for (int k = 0; k <= 10000; ++k) {
+    t.push_back(1.0 + k * dt);
+    y.push_back(1.0 - std::exp(-k * dt / tau));
+  }
+  const StepResponse r = step_response(t, y, 1.0, 0.0, 1.0);
+  EXPECT_NEAR(r.rise_s, tau * std::log(10.0), 1e-6);
+  EXPECT_NEAR(r.settling_s, tau * std::log(10.0), 1e-6);
+  EXPECT_EQ(r.overshoot_pct, 0.0);
+}
+
+TEST(HilReport, FindStepSkipsShortLevels) {
+  // 0.1 s at 0, 1 s at 500, then 1500 for 3 s: the first step held >= 0.5 s is 500 -> 1500 at t = 1.1 s,
+  // window capped at 2 s.
+  std::vector<double> r;
+  for (int k = 0; k < 10; ++k) r.push_back(0);
+  for (int k = 0; k < 100; ++k) r.push_back(500);
+  for (int k = 0; k < 300; ++k) r.push_back(1500);
+  const auto w = find_step(r, 0.01);
+  ASSERT_TRUE(w.has_value());
+  EXPECT_EQ(w->begin, 110u);
+  EXPECT_EQ(w->end, 310u);
+  EXPECT_DOUBLE_EQ(w->y0, 500);
+  EXPECT_DOUBLE_EQ(w->y1, 1500);
+  EXPECT_NEAR(w->t_step_s, 1.1, 1e-12);
+  EXPECT_FALSE(find_step(std::vector<double>(50, 3.0), 0.01).has_value());
+}

@@ -13,7 +13,8 @@
 namespace lash::hil {
 
 /// The first reference step (a jump between two samples) whose previous level was held
-/// for at least min_hold_s; the window ends at the next jump or at the end of the trace.
+/// for at least min_hold_s; the window ends at the next jump, after max_window_s, or at
+/// the end of the trace.
 struct StepWindow {
   std::size_t begin = 0;  ///< first sample at the new level
   std::size_t end = 0;    ///< one past the last sample of the window
@@ -21,7 +22,8 @@ struct StepWindow {
   double y0 = 0.0;        ///< reference level before the step
   double y1 = 0.0;        ///< reference level after the step
 };
-std::optional<StepWindow> find_step(const std::vector<double>& reference, double dt_s, double min_hold_s = 0.5);
+std::optional<StepWindow> find_step(const std::vector<double>& reference, double dt_s, double min_hold_s = 0.5,
+                                    double max_window_s = 2.0);
 
 /// Thesis step-response figures of samples y at times t (t ≥ t_step), step y0 → y1:
 /// 90 % rise = first crossing of y0 + 0.9(y1 − y0) (interpolated), 10 % settling = last exit

@@ -66,6 +66,7 @@ class Rls {
   /// Not real-time safe only in that it may throw (invalid config).
   explicit Rls(const RlsConfig<N>& cfg = {}) : cfg_(cfg) {
     cfg_.validate();
+    inv_lambda_ = 1.0 / cfg_.lambda;
     reset();
   }
 
@@ -99,18 +100,19 @@ class Rls {
       for (std::size_t j = 0; j < N; ++j) s += p_[i][j] * phi[j];
       pphi[i] = s;
     }
-    double r = 0.0;  // φᵀ P φ
-    for (std::size_t i = 0; i < N; ++i) r += phi[i] * pphi[i];
+    const double r = quad(phi);  // φᵀ P φ, summed as a tree (short dependency chain)
     const double err = y - yhat;
     if (cfg_.forgetting == Forgetting::exponential) {
-      // eq. 16: q = Pφ / (λ + φᵀPφ); eq. 13: η += q e; eq. 15: P = (P − q φᵀ P)/λ
+      // eq. 16: q = Pφ / (λ + φᵀPφ); eq. 13: η += q e; eq. 15: P = (P − q φᵀ P)/λ.
+      // Trace bound: the 1/λ inflation is skipped when trace(P(k−1))/λ would exceed trace_max;
+      // since the subtracted term is positive semi-definite, trace P ≤ max(trace_max, trace P0).
+      double tr = 0.0;
+      for (std::size_t i = 0; i < N; ++i) tr += p_[i][i];
+      const double scale = tr * inv_lambda_ > cfg_.trace_max ? 1.0 : inv_lambda_;
       const double inv = 1.0 / (cfg_.lambda + r);
       for (std::size_t i = 0; i < N; ++i) eta_[i] += pphi[i] * inv * err;
-      double tr = 0.0;
-      for (std::size_t i = 0; i < N; ++i) tr += p_[i][i] - pphi[i] * pphi[i] * inv;
-      const double scale = tr > cfg_.trace_max * cfg_.lambda ? 1.0 : 1.0 / cfg_.lambda;
       for (std::size_t i = 0; i < N; ++i)
-        for (std::size_t j = i; j < N; ++j) p_[i][j] = (p_[i][j] - pphi[i] * pphi[j] * inv) * scale;
+        for (std::size_t j = i; j < N; ++j) p_[i][j] = p_[i][j] * scale - (pphi[i] * pphi[j] * scale) * inv;
     } else {
       // Directional forgetting (Bittanti, Bolzern & Campi 1990; Cao & Schwartz 2000):
       // q = Pφ/(1 + r); P = P − Pφφᵀ P/(β⁻¹ + r), β = λ − (1 − λ)/r; P unchanged when r = 0.
@@ -161,8 +163,8 @@ class Rls {
     const double err = y - yhat;
     for (std::size_t i = 0; i < N; ++i) eta_[i] += pz[i] * inv * err;
     double tr = 0.0;
-    for (std::size_t i = 0; i < N; ++i) tr += p_[i][i] - pz[i] * phip[i] * inv;
-    const double scale = tr > cfg_.trace_max * cfg_.lambda ? 1.0 : 1.0 / cfg_.lambda;
+    for (std::size_t i = 0; i < N; ++i) tr += p_[i][i];
+    const double scale = tr * inv_lambda_ > cfg_.trace_max ? 1.0 : inv_lambda_;
     for (std::size_t i = 0; i < N; ++i)
       for (std::size_t j = 0; j < N; ++j) p_[i][j] = (p_[i][j] - pz[i] * phip[j] * inv) * scale;
     project();
@@ -188,12 +190,29 @@ class Rls {
     for (std::size_t i = 0; i < N; ++i) ok = ok && std::isfinite(phi[i]);
     return ok;
   }
+  /// φᵀPφ for symmetric P: the φ products do not depend on P, and the terms are added
+  /// pairwise, so the chain from P(k−1) to the division is short (see bench/bench_identify.cpp).
+  double quad(const Vec& phi) const noexcept {
+    if constexpr (N == 3) {
+      const double d = (p_[0][0] * (phi[0] * phi[0]) + p_[1][1] * (phi[1] * phi[1])) + p_[2][2] * (phi[2] * phi[2]);
+      const double o = (p_[0][1] * (phi[0] * phi[1]) + p_[0][2] * (phi[0] * phi[2])) + p_[1][2] * (phi[1] * phi[2]);
+      return d + 2.0 * o;
+    } else {
+      double d = 0.0, o = 0.0;
+      for (std::size_t i = 0; i < N; ++i) {
+        d += p_[i][i] * (phi[i] * phi[i]);
+        for (std::size_t j = i + 1; j < N; ++j) o += p_[i][j] * (phi[i] * phi[j]);
+      }
+      return d + 2.0 * o;
+    }
+  }
   void project() noexcept {
     for (std::size_t i = 0; i < N; ++i)
       eta_[i] = eta_[i] < cfg_.lower[i] ? cfg_.lower[i] : (eta_[i] > cfg_.upper[i] ? cfg_.upper[i] : eta_[i]);
   }
 
   RlsConfig<N> cfg_;
+  double inv_lambda_ = 1.0;
   Vec eta_{};
   Mat p_{};
   std::uint64_t updates_ = 0;

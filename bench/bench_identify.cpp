@@ -1,0 +1,106 @@
+// Estimator throughput: one (v, y) sample per step() (SPEC A4; goal: deadzone-deadband >= 50 M samples/s).
+// Data: the E1 plant (thesis eq. 34), v = 600 sin(t), precomputed so only the estimator is timed.
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <vector>
+
+#include "lash/identify/estimators.hpp"
+#include "lash/identify/rls.hpp"
+#include "lash/plant/plant.hpp"
+
+namespace {
+
+struct Data {
+  std::vector<double> v, y;
+};
+
+const Data& e1_data() {
+  static const Data d = [] {
+    using namespace lash;
+    std::vector<Block> b;
+    b.emplace_back(Deadzone({-300.0, 200.0}));
+    b.emplace_back(FirstOrder({{-0.96, 0.1}, {-0.94, 0.15}}));
+    b.emplace_back(Deadband({30.0, 50.0}));
+    Plant p(std::move(b), 0.005);
+    Data out;
+    const std::size_t n = 1 << 16;  // 327 s: a whole number of input periods is not needed
+    for (std::size_t k = 0; k < n; ++k) {
+      const double v = 600.0 * std::sin(0.005 * static_cast<double>(k));
+      out.v.push_back(v);
+      out.y.push_back(p.step(v));
+    }
+    return out;
+  }();
+  return d;
+}
+
+lash::EstimatorConfig thesis(lash::ModelKind m) {
+  lash::EstimatorConfig c;
+  c.model = m;
+  c.dt_s = 0.005;
+  c.guess_left = -350;
+  c.guess_right = 350;
+  return c;
+}
+
+template <class E>
+void run(benchmark::State& state, const lash::EstimatorConfig& cfg) {
+  const Data& d = e1_data();
+  const std::size_t mask = d.v.size() - 1;
+  E est(cfg);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    double yhat = est.step(d.v[i], d.y[i]);
+    benchmark::DoNotOptimize(yhat);
+    i = (i + 1) & mask;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+
+void BM_DeadzoneDeadband(benchmark::State& s) {
+  run<lash::DeadzoneDeadbandEstimator>(s, thesis(lash::ModelKind::deadzone_deadband));
+}
+BENCHMARK(BM_DeadzoneDeadband);
+
+void BM_DeadzoneDeadbandE2Settings(benchmark::State& s) {
+  auto c = thesis(lash::ModelKind::deadzone_deadband);
+  c.pooled = true;
+  c.method = lash::EstimationMethod::iv;
+  c.iv_delay = 45;
+  c.direction_run = 41;
+  c.rls.lambda = 1.0;
+  c.noise.filter_length = 40;
+  c.noise.filter_input = true;
+  c.noise.derivative_filter_length = 20;
+  c.noise.derivative_threshold = 150;
+  c.noise.align_delay = 10;
+  run<lash::DeadzoneDeadbandEstimator>(s, c);
+}
+BENCHMARK(BM_DeadzoneDeadbandE2Settings);
+
+void BM_InputDeadzone(benchmark::State& s) {
+  run<lash::InputDeadzoneEstimator>(s, thesis(lash::ModelKind::input_deadzone));
+}
+BENCHMARK(BM_InputDeadzone);
+
+void BM_Linear(benchmark::State& s) { run<lash::LinearEstimator>(s, thesis(lash::ModelKind::linear)); }
+BENCHMARK(BM_Linear);
+
+void BM_Rls3Update(benchmark::State& state) {
+  lash::RlsConfig<3> c;
+  c.lambda = 0.99;
+  lash::Rls<3> r(c);
+  const Data& d = e1_data();
+  const std::size_t mask = d.v.size() - 1;
+  std::size_t i = 1;
+  for (auto _ : state) {
+    double yhat = r.update({-d.y[i - 1], d.v[i - 1], 1.0}, d.y[i]);
+    benchmark::DoNotOptimize(yhat);
+    i = ((i + 1) & mask) | 1;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_Rls3Update);
+
+}  // namespace

@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# Bad input to lash hil: exit 2 with a message naming file, line and field; nothing written.
+# A master without a slave: exit 1 with a clear error after the DTO timeout.
+set -u
+fail() { echo "FAIL: $*"; exit 1; }
+tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+src=${LASH_SOURCE_DIR}
+
+expect2() {  # expect2 PATTERN ARGS...
+  local pat=$1; shift
+  "$LASH" "$@" >"$tmp/out" 2>"$tmp/err"; local rc=$?
+  [[ $rc == 2 ]] || fail "expected exit 2, got $rc: $* ($(cat "$tmp/err"))"
+  grep -q -- "$pat" "$tmp/err" || fail "message lacks '$pat': $(cat "$tmp/err")"
+  echo "ok (exit 2): $(head -1 "$tmp/err")"
+}
+
+expect2 "--reference" hil simulate --reference bogus:amplitude=1 -o "$tmp/a.csv"
+expect2 "--reference" hil simulate --reference square:amplitude=x -o "$tmp/a.csv"
+expect2 "--duration" hil simulate --duration 0 -o "$tmp/a.csv"
+[[ -e "$tmp/a.csv" ]] && fail "output written despite bad input"
+
+write_cfg() {  # write_cfg EXTRA_CONTROLLER_LINE [DTO_LOG]
+  cat >"$tmp/bench.toml" <<TOML
+dbc = "$src/config/hydraulic_bench.dbc"
+dto_log = "${2:-$src/config/hil/ccp_connect.log}"
+[controller]
+kp = 1.0
+$1
+TOML
+}
+write_cfg "ki_per_s = -3"
+expect2 "bench.toml:5" hil simulate --config "$tmp/bench.toml" -o "$tmp/b.csv"
+write_cfg "kq = 3"
+expect2 "kq" hil simulate --config "$tmp/bench.toml" -o "$tmp/b.csv"
+printf '(1.000000) can0 7E0#0100000000000000\n(1.000100) can0 123#00\n' >"$tmp/nodto.log"
+write_cfg "" "$tmp/nodto.log"
+expect2 "nodto.log" hil simulate --config "$tmp/bench.toml" -o "$tmp/b.csv"
+[[ -e "$tmp/b.csv" ]] && fail "output written despite bad input"
+
+# No slave on an in-process bus: the master gives up after its DTO timeout.
+"$LASH" hil master --bus mem:lonely --dto-timeout 0.1 --duration 1 --log "$tmp/m.csv" 2>"$tmp/err"; rc=$?
+[[ $rc == 1 ]] || fail "master without slave: expected exit 1, got $rc"
+grep -q "no positive DTO reply to CCP CONNECT" "$tmp/err" || fail "no clear DTO timeout message: $(cat "$tmp/err")"
+grep -q "dto_timeout" "$tmp/m.events.csv" || fail "DTO timeout not in the events log"
+echo "ok (exit 1): $(grep error "$tmp/err")"
+echo PASS
