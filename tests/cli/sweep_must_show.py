@@ -49,8 +49,9 @@ def check_common(name, summary, rows, expected_runs):
         if r["identified_r"] == "1" and r["identified_l"] == "1" and not cl <= cr:
             fail.append(f"{name} run {r['run']}: identified c_l = {cl} > c_r = {cr}")
     per = {w: f"{v['good']}/{v['runs']}" for w, v in summary["per_waveform"].items()}
+    pc = lambda x: "nan" if x is None else f"{100 * x:.2f}"
     print(f"{name}: {good}/{len(rows)} = {100 * share:.1f} % NRMSE < 10 %  per waveform {per}  "
-          f"median {100 * summary['median_nrmse']:.2f} %  worst {100 * summary['worst_nrmse']:.1f} % ({summary['worst_run']})  "
+          f"median {pc(summary['median_nrmse'])} %  worst {pc(summary['worst_nrmse'])} % ({summary['worst_run']})  "
           f"params within 5 %: {summary['params_within_tolerance']}/{summary['params_checked']}")
     return share
 
