@@ -27,6 +27,9 @@ struct Command {
 /// Each subcommand file defines one of these.
 Command add_simulate(CLI::App& app);
 Command add_demo(CLI::App& app);
+Command add_closed_loop(CLI::App& app);
+Command add_tune(CLI::App& app);
+Command add_identify_steps(CLI::App& app);
 Command add_estimate(CLI::App& app);
 Command add_sweep(CLI::App& app);
 Command add_can(CLI::App& app);

@@ -11,6 +11,9 @@ int main(int argc, char** argv) {
   std::vector<Command> commands{
       add_simulate(app),
       add_demo(app),
+      add_closed_loop(app),
+      add_tune(app),
+      add_identify_steps(app),
       add_estimate(app),
       add_sweep(app),
       add_can(app),

@@ -293,11 +293,11 @@ bool MessageCodec::decode(std::span<const std::uint8_t> data, std::span<double> 
   if (values.size() != codecs_.size() || data.size() < message_.size) return false;
   if (packed_) {
     const std::uint64_t le = load_le(data, message_.size);
-    const std::uint64_t be = __builtin_bswap64(le);
+    const std::uint64_t words[2] = {le, __builtin_bswap64(le)};  // [motorola]
     std::uint64_t mux = 0;
     if (has_mux_) {
       const Lane& m = lanes_[mux_index_];
-      mux = ((m.motorola ? be : le) >> m.lo) & m.mask;
+      mux = (words[m.motorola] >> m.lo) & m.mask;
     }
     const std::size_t n = lanes_.size();
     for (std::size_t i = 0; i < n; ++i) {
@@ -306,7 +306,7 @@ bool MessageCodec::decode(std::span<const std::uint8_t> data, std::span<double> 
         values[i] = std::numeric_limits<double>::quiet_NaN();
         continue;
       }
-      const std::uint64_t raw = ((l.motorola ? be : le) >> l.lo) & l.mask;
+      const std::uint64_t raw = (words[l.motorola] >> l.lo) & l.mask;
       if (!l.integer) {
         values[i] = codecs_[i].to_physical(raw);
         continue;
@@ -345,7 +345,7 @@ MessageCodec::EncodeResult MessageCodec::encode(std::span<const double> values, 
   }
   if (packed_) {
     // Bits to clear/set, kept per byte order and merged into one word at the end.
-    std::uint64_t clear_le = 0, set_le = 0, clear_be = 0, set_be = 0;
+    std::uint64_t clear[2] = {0, 0}, set[2] = {0, 0};  // [motorola]
     const std::size_t n = lanes_.size();
     for (std::size_t i = 0; i < n; ++i) {
       const Lane& l = lanes_[i];
@@ -391,16 +391,11 @@ MessageCodec::EncodeResult MessageCodec::encode(std::span<const double> values, 
         }
       }
       res.clamped += clamped ? 1u : 0u;
-      if (l.motorola) {
-        clear_be |= l.mask << l.lo;
-        set_be |= raw << l.lo;
-      } else {
-        clear_le |= l.mask << l.lo;
-        set_le |= raw << l.lo;
-      }
+      clear[l.motorola] |= l.mask << l.lo;
+      set[l.motorola] |= raw << l.lo;
     }
     std::uint64_t w = load_le(data, message_.size);
-    w = (w & ~(clear_le | __builtin_bswap64(clear_be))) | set_le | __builtin_bswap64(set_be);
+    w = (w & ~(clear[0] | __builtin_bswap64(clear[1]))) | set[0] | __builtin_bswap64(set[1]);
     if (data.size() >= 8) {
       if constexpr (std::endian::native == std::endian::big) w = __builtin_bswap64(w);
       std::memcpy(data.data(), &w, 8);

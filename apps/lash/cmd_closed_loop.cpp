@@ -1,0 +1,118 @@
+// lash closed-loop: the SPEC B2 closed loop (PID + deadzone inverse + saturation around the
+// SPEC B1 pilot valve) simulated (a) discretely and (b) continuously with ode3; step metrics of both.
+#include <cmath>
+
+#include <fmt/core.h>
+#include <nlohmann/json.hpp>
+
+#include "cli_common.hpp"
+#include "plot.hpp"
+#include "lash/control/closed_loop.hpp"
+#include "lash/control/gains_file.hpp"
+
+namespace lash::cli {
+namespace {
+
+struct Options {
+  std::string gains;
+  double r0 = 0.0, r1 = 1000.0, settle = 1.0, after = 1.0;
+  double deadzone = 288.0, gain = 2.15, tau = 0.07, tau2 = 0.0, bias = 90.1, sigma = 0.0;
+  bool no_quantize = false;
+  std::uint64_t seed = 1;
+  std::size_t bus_delay = 0;
+  bool json = false;
+  std::string out, plot;
+};
+
+nlohmann::json metrics_json(const StepMetrics& m) {
+  auto num = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
+  return {{"rise_s", num(m.rise_s)}, {"settling_s", num(m.settling_s)}, {"overshoot_pct", num(m.overshoot_pct)}};
+}
+
+int run(const Options& o) {
+  const std::string gains_path = o.gains.empty() ? source_dir() + "/config/control/thesis_gains.toml" : o.gains;
+  ControllerConfig c = load_controller_config(gains_path);
+  PilotValveParams p;
+  p.deadzone_mA = o.deadzone;
+  p.gain_kPa_per_mA = o.gain;
+  p.tau_s = o.tau;
+  p.tau2_s = o.tau2;
+  p.bias_kPa = o.bias;
+  p.noise_sigma_kPa = o.sigma;
+  p.quantize = !o.no_quantize;
+  p.seed = o.seed;
+  p.dt_s = c.pid.dt_s;
+  try {
+    p.validate();
+  } catch (const std::invalid_argument& e) {
+    throw InputError("", 0, "plant option", e.what());
+  }
+  StepTest st{o.r0, o.r1, o.settle, o.after};
+  const StepResult d = run_step_test(Solver::discrete, p, c, st, o.bus_delay);
+  const StepResult c3 = run_step_test(Solver::ode3, p, c, st);
+  const double ratio = c3.metrics.overshoot_pct > 0 ? d.metrics.overshoot_pct / c3.metrics.overshoot_pct : NAN;
+  if (!o.out.empty()) {
+    const auto& a = d.trace;
+    const auto& b = c3.trace;
+    write_columns_csv(o.out,
+                      {"t", "reference_kPa", "discrete_measured_kPa", "discrete_pressure_kPa", "discrete_command_mA",
+                       "ode3_measured_kPa", "ode3_pressure_kPa", "ode3_command_mA"},
+                      {&a.t_s, &a.reference_kPa, &a.measured_kPa, &a.pressure_kPa, &a.command_mA, &b.measured_kPa,
+                       &b.pressure_kPa, &b.command_mA});
+    if (!o.plot.empty())
+      plot_csv(o.out, o.plot, "lash closed-loop: discrete vs ode3", {{"pressure [kPa]", "t [s]"}, {"current [mA]", "t [s]"}},
+               {{"t", "reference_kPa", "reference", 0},
+                {"t", "discrete_measured_kPa", "discrete", 0},
+                {"t", "ode3_measured_kPa", "ode3", 0},
+                {"t", "discrete_command_mA", "discrete", 1},
+                {"t", "ode3_command_mA", "ode3", 1}});
+  }
+  if (o.json) {
+    nlohmann::json j;
+    j["gains"] = {{"kp", c.pid.gains.kp}, {"ki", c.pid.gains.ki_per_s}, {"kd", c.pid.gains.kd_s},
+                  {"n", c.pid.gains.n_per_s}, {"dt_s", c.pid.dt_s}};
+    j["step"] = {{"r0_kPa", o.r0}, {"r1_kPa", o.r1}};
+    j["discrete"] = metrics_json(d.metrics);
+    j["ode3"] = metrics_json(c3.metrics);
+    j["discrete_measured"] = metrics_json(d.measured_metrics);
+    j["ode3_measured"] = metrics_json(c3.measured_metrics);
+    j["overshoot_ratio_discrete_over_ode3"] = std::isfinite(ratio) ? nlohmann::json(ratio) : nlohmann::json(nullptr);
+    fmt::print("{}\n", j.dump());
+  } else {
+    fmt::print("closed loop, step {} -> {} kPa, T = {} s, gains {}\n", format_double(o.r0), format_double(o.r1),
+               format_double(c.pid.dt_s), gains_path);
+    fmt::print("{:<10} {:>12} {:>14} {:>14}\n", "solver", "rise90 [s]", "settle10 [s]", "overshoot [%]");
+    for (auto [name, m] : {std::pair{"discrete", d.metrics}, std::pair{"ode3", c3.metrics}})
+      fmt::print("{:<10} {:>12.4f} {:>14.4f} {:>14.2f}\n", name, m.rise_s, m.settling_s, m.overshoot_pct);
+    fmt::print("overshoot ratio discrete/ode3 = {:.3f} (thesis 59/32 = {:.3f})\n", ratio, 59.0 / 32.0);
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+Command add_closed_loop(CLI::App& app) {
+  auto o = std::make_shared<Options>();
+  auto* sub = app.add_subcommand(
+      "closed-loop", "Step response of the pilot-valve closed loop: discrete solver vs continuous ode3 (SPEC B2)");
+  sub->add_option("--gains", o->gains, "Controller TOML (default config/control/thesis_gains.toml)");
+  sub->add_option("--r0", o->r0, "Reference before the step [kPa]");
+  sub->add_option("--r1", o->r1, "Reference after the step [kPa]");
+  sub->add_option("--settle", o->settle, "Time at r0 before the step [s]");
+  sub->add_option("--after", o->after, "Time at r1 after the step [s]");
+  sub->add_option("--deadzone", o->deadzone, "Plant deadzone [mA]");
+  sub->add_option("--gain", o->gain, "Plant gain [kPa/mA]");
+  sub->add_option("--tau", o->tau, "Plant time constant [s]");
+  sub->add_option("--tau2", o->tau2, "Optional second lag [s] (0 = none)");
+  sub->add_option("--bias", o->bias, "Pressure at zero current [kPa]");
+  sub->add_option("--noise-sigma", o->sigma, "Sensor noise sigma [kPa] (metrics use the noise-free pressure)");
+  sub->add_flag("--no-quantize", o->no_quantize, "Skip the uint16 sensor code");
+  sub->add_option("--seed", o->seed, "Noise seed");
+  sub->add_option("--bus-delay", o->bus_delay, "Extra command delay of the discrete loop [samples]");
+  sub->add_flag("--json", o->json, "Print one JSON object");
+  sub->add_option("-o,--output", o->out, "Write both traces as CSV");
+  sub->add_option("--plot", o->plot, "Also render a PNG (needs -o)");
+  return {sub, [o] { return run(*o); }};
+}
+
+}  // namespace lash::cli
