@@ -51,11 +51,35 @@ struct DumpOptions {
   double timeout_s = -1;
   std::string log;
   std::string iface;
+  std::vector<std::string> filters;
   bool quiet = false;
 };
 
+/// "ID:MASK" in hex; 8 hex digits in ID make it a 29-bit filter (like cansend ids).
+can::Filter parse_filter(const std::string& text) {
+  const auto colon = text.find(':');
+  const std::string id = text.substr(0, colon);
+  const std::string mask = colon == std::string::npos ? (id.size() == 8 ? "1FFFFFFF" : "7FF") : text.substr(colon + 1);
+  can::Filter f;
+  f.extended = id.size() == 8;
+  std::size_t used1 = 0, used2 = 0;
+  try {
+    f.id = static_cast<std::uint32_t>(std::stoul(id, &used1, 16));
+    f.mask = static_cast<std::uint32_t>(std::stoul(mask, &used2, 16));
+  } catch (const std::exception&) {
+    used1 = 0;
+  }
+  if ((id.size() != 3 && id.size() != 8) || used1 != id.size() || used2 != mask.size() ||
+      f.id > (f.extended ? 0x1FFFFFFFu : 0x7FFu))
+    throw InputError("", 0, "--filter", "expected ID:MASK in hex with a 3- or 8-digit id, got '" + text + "'");
+  return f;
+}
+
 int run_dump(const DumpOptions& o) {
+  std::vector<can::Filter> filters;
+  for (const auto& t : o.filters) filters.push_back(parse_filter(t));
   auto bus = can::open_bus(o.bus);
+  if (!filters.empty()) bus->set_filters(filters);
   const std::string iface = o.iface.empty() ? default_iface(o.bus) : o.iface;
   std::unique_ptr<AtomicFile> log;
   if (!o.log.empty()) log = std::make_unique<AtomicFile>(o.log);
@@ -301,6 +325,7 @@ Command add_can(CLI::App& app) {
   d->add_option("--log", dump->log, "Also write the frames as a candump -L log (written on exit)");
   d->add_option("--iface", dump->iface, "Interface name written in the lines (default: the socketcan name or can0)");
   d->add_flag("--quiet", dump->quiet, "Do not print frames to stdout");
+  d->add_option("--filter", dump->filters, "Accept only ID:MASK (hex; 8-digit id = 29-bit); repeatable");
   auto send = std::make_shared<SendOptions>();
   auto* s = sub->add_subcommand("send", "Send frames given as ID#HEX (cansend syntax)");
   s->add_option("--bus", send->bus, "Bus address")->required();

@@ -44,8 +44,9 @@ set +e
 $L can send --bus mem:x 123#GG 2>"$tmp/err"; rc1=$?
 $L can dump --bus nope:x --log "$tmp/never.log" 2>/dev/null; rc2=$?
 $L can dump --bus socketcan:lash_nosuch0 --count 1 2>"$tmp/err2"; rc3=$?
+$L can dump --bus mem:x --filter 12:7FF --count 1 2>/dev/null; rc4=$?
 set -e
-expect "$rc1 $rc2 $rc3" "2 2 2"
+expect "$rc1 $rc2 $rc3 $rc4" "2 2 2 2"
 [[ ! -e "$tmp/never.log" ]] || fail "a log file was left behind"
 grep -q "socketcan" "$tmp/err2" || fail "socketcan error: $(cat "$tmp/err2")"
 echo "can_cli: ok"

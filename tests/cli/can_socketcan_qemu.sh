@@ -96,6 +96,14 @@ lash can send --bus socketcan:vcan0 123#DEADBEEF 1ABCDEF0#0102030405060708 7FF#R
 wait $!
 echo "LASH-DUMP-RC $?"
 while read -r line; do echo "LASH-SENT $line"; done < /tmp/sent.log
+# kernel filters (CAN_RAW_FILTER): only 0x1xx standard ids and one extended id pass
+lash can dump --bus socketcan:vcan0 --filter 100:700 --filter 18FF0000:1FFF0000 --count 3 --timeout 20 > /tmp/filt.out 2>/tmp/filt.err &
+sleep 1
+lash can send --bus socketcan:vcan0 223#01 123#02 18FE0001#03 100#04 18FF0002#05 1FF#06
+wait $!
+echo "LASH-FILT-RC $?"
+while read -r line; do echo "LASH-FILTERED $line"; done < /tmp/filt.out
+echo "LASH-FILT-STATS $(cat /tmp/filt.err)"
 # replay timing
 # The dumper runs at the lowest priority, the replayer under SCHED_FIFO: on one vCPU
 # the dumper must not delay a frame (timestamps are taken by the kernel in the send path).
@@ -146,6 +154,14 @@ want = ["123#DEADBEEF", "1ABCDEF0#0102030405060708", "7FF#R", "000#"]
 print("send -> dump over socketcan:vcan0:", sent)
 if sent != want:
     fail.append("dump got %s, expected %s" % (sent, want))
+filt = [s.split()[2] for s in tagged("LASH-FILTERED")]
+print("dump --filter 100:700 --filter 18FF0000:1FFF0000 got:", filt)
+if filt != ["123#02", "100#04", "18FF0002#05"]:
+    fail.append("kernel filters: got %s, expected 123#02, 100#04, 18FF0002#05" % filt)
+stats = tagged("LASH-FILT-STATS")
+print("filter dump stats:", stats)
+if not stats or "(0 filtered" not in stats[0]:
+    fail.append("the kernel (CAN_RAW_FILTER) should have dropped the others before user space: %s" % stats)
 orig = []
 for l in open(sys.argv[0] if False else log.replace("console.log", "initrd/replay.log")):
     orig.append(float(l.split()[0][1:-1]))
