@@ -19,7 +19,7 @@ rng = np.random.default_rng(1)
 v = 100.0 + 50.0 * rng.standard_normal(n)
 y = np.zeros(n)
 for k in range(1, n):
-    y[k] = 0.9 * y[k - 1] + 0.5 * v[k - 1] + 3.0
+    y[k] = 0.9 * y[k - 1] + 0.5 * v[k - 1] + 150.0
 y += 2.0 * rng.standard_normal(n)
 
 with tempfile.TemporaryDirectory() as d:
@@ -27,7 +27,7 @@ with tempfile.TemporaryDirectory() as d:
     np.savetxt(path, np.column_stack([np.arange(n) * 0.01, v, y]), delimiter=",", header="t,v,y", comments="",
                fmt="%.17g")
     t0 = time.perf_counter()
-    p = subprocess.run([lash, "estimate", "--model", "input-deadzone", "--guess-left", "-1e9", "--guess-right", "-1e6",
+    p = subprocess.run([lash, "estimate", "--model", "input-deadzone", "--guess-left", "-1e9", "--guess-right", "-250",
                         "--lambda", "1", "--p0", "1e6", "--min-updates", "1", "--timing", "--json", path],
                        check=True, capture_output=True, text=True)
     lash_wall = time.perf_counter() - t0

@@ -9,6 +9,7 @@
 #include "plot.hpp"
 #include "lash/control/closed_loop.hpp"
 #include "lash/control/gains_file.hpp"
+#include "lash/control/model_based.hpp"
 
 namespace lash::cli {
 namespace {
@@ -21,12 +22,49 @@ struct Options {
   std::uint64_t seed = 1;
   std::size_t bus_delay = 0;
   bool json = false;
+  bool online = false;
   std::string out, plot;
 };
 
 nlohmann::json metrics_json(const StepMetrics& m) {
   auto num = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
   return {{"rise_s", num(m.rise_s)}, {"settling_s", num(m.settling_s)}, {"overshoot_pct", num(m.overshoot_pct)}};
+}
+
+// Beyond the thesis: thesis gains vs gains + deadzone inverse from the online RLS estimate,
+// on the virtual pilot-valve rig and on the B1 model with a second pole (tau2, default 8 ms).
+int run_online(const Options& o, const ControllerConfig& thesis, const StepTest& st) {
+  const rigs::PilotValveRigParams rp;
+  const double dt = thesis.pid.dt_s;
+  const FirstOrderDeadzoneModel m = identify_online_on_rig(rp, dt, o.seed);
+  const ControllerConfig online = design_for_rise(m, rp.bias_kPa, 0.11, dt, st);
+  PilotValveParams b1;
+  b1.tau2_s = o.tau2 > 0 ? o.tau2 : 0.008;
+  b1.seed = o.seed;
+  b1.dt_s = dt;
+  const auto th_rig = run_step_on_rig(rp, thesis, st, o.seed).metrics;
+  const auto on_rig = run_step_on_rig(rp, online, st, o.seed).metrics;
+  const auto th_b1 = run_step_test(Solver::discrete, b1, thesis, st).metrics;
+  const auto on_b1 = run_step_test(Solver::discrete, b1, online, st).metrics;
+  if (o.json) {
+    nlohmann::json j;
+    j["online_model"] = {{"gain_kPa_per_mA", m.gain_kPa_per_mA}, {"tau_s", m.tau_s}, {"deadzone_mA", m.deadzone_mA}};
+    j["online_gains"] = {{"kp", online.pid.gains.kp}, {"ki", online.pid.gains.ki_per_s},
+                         {"offset_mA", online.dz_inverse.offset_right}};
+    j["rig"] = {{"thesis", metrics_json(th_rig)}, {"online", metrics_json(on_rig)}};
+    j["b1_second_pole"] = {{"thesis", metrics_json(th_b1)}, {"online", metrics_json(on_b1)}};
+    fmt::print("{}\n", j.dump());
+    return kExitOk;
+  }
+  fmt::print("online RLS estimate on the rig: K = {:.4f} kPa/mA, tau = {:.4f} s, c = {:.2f} mA\n", m.gain_kPa_per_mA,
+             m.tau_s, m.deadzone_mA);
+  fmt::print("designed PI: kp = {:.4f} mA/kPa, ki = {:.4f} mA/(kPa s), deadzone inverse {:.2f} mA, clamp anti-windup\n",
+             online.pid.gains.kp, online.pid.gains.ki_per_s, online.dz_inverse.offset_right);
+  fmt::print("{:<22} {:>12} {:>14} {:>14}\n", "plant / controller", "rise90 [s]", "settle10 [s]", "overshoot [%]");
+  for (auto [name, mm] : {std::pair{"rig / thesis", th_rig}, std::pair{"rig / online", on_rig},
+                          std::pair{"B1+pole / thesis", th_b1}, std::pair{"B1+pole / online", on_b1}})
+    fmt::print("{:<22} {:>12.4f} {:>14.4f} {:>14.2f}\n", name, mm.rise_s, mm.settling_s, mm.overshoot_pct);
+  return kExitOk;
 }
 
 int run(const Options& o) {
@@ -48,6 +86,7 @@ int run(const Options& o) {
     throw InputError("", 0, "plant option", e.what());
   }
   StepTest st{o.r0, o.r1, o.settle, o.after};
+  if (o.online) return run_online(o, c, st);
   const StepResult d = run_step_test(Solver::discrete, p, c, st, o.bus_delay);
   const StepResult c3 = run_step_test(Solver::ode3, p, c, st);
   const double ratio = c3.metrics.overshoot_pct > 0 ? d.metrics.overshoot_pct / c3.metrics.overshoot_pct : NAN;
@@ -110,6 +149,9 @@ Command add_closed_loop(CLI::App& app) {
   sub->add_option("--seed", o->seed, "Noise seed");
   sub->add_option("--bus-delay", o->bus_delay, "Extra command delay of the discrete loop [samples]");
   sub->add_flag("--json", o->json, "Print one JSON object");
+  sub->add_flag("--online", o->online,
+                "Beyond the thesis: compare the gains with a PI + deadzone inverse designed from the online RLS "
+                "estimate, on the virtual pilot-valve rig and on B1 + a second pole");
   sub->add_option("-o,--output", o->out, "Write both traces as CSV");
   sub->add_option("--plot", o->plot, "Also render a PNG (needs -o)");
   return {sub, [o] { return run(*o); }};

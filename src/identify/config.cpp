@@ -70,6 +70,8 @@ void EstimatorConfig::validate() const {
   require(iv_delay >= 1 && iv_delay <= 60, "iv-delay", "must be in 1..60 samples");
   require(direction_run >= 2 && direction_run <= 1000000, "direction-run", "must be in 2..1000000 samples");
   require(min_updates >= 1, "min-updates", "must be >= 1");
+  require(std::isfinite(settle_tol) && settle_tol > 0, "settle-tol", "must be > 0");
+  require(settle_updates <= 1000000, "settle-updates", "must be <= 1000000");
   require(std::isfinite(singular_tol) && singular_tol > 0, "singular-tol", "must be > 0");
   require(std::isfinite(zero_threshold) && zero_threshold >= 0, "zero-threshold", "must be >= 0");
   require(accel_limit > 0, "accel-limit", "must be > 0");

@@ -45,6 +45,8 @@ void read_estimator_config(TomlTable& t, EstimatorConfig& c, EstimationJob* job)
   c.direction_run = static_cast<std::uint32_t>(count(t, "direction_run", c.direction_run, 2, 1000000));
   c.min_updates = count(t, "min_updates", c.min_updates, 1, 1000000000);
   c.singular_tol = t.number_or("singular_tol", c.singular_tol);
+  c.settle_tol = t.number_or("settle_tol", c.settle_tol);
+  c.settle_updates = static_cast<std::uint32_t>(count(t, "settle_updates", c.settle_updates, 0, 1000000));
   c.zero_threshold = t.number_or("zero_threshold", c.zero_threshold);
   c.accel_limit = t.number_or("accel_limit", c.accel_limit);
   c.stage2_start_s = t.number_or("stage2_start", c.stage2_start_s);

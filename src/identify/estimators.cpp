@@ -67,7 +67,8 @@ void InputDeadzoneEstimator::refresh(int i) noexcept {
   sb1_[i] = e[1];
   const bool ok = rls_[i].updates() >= cfg_.min_updates && std::fabs(e[1]) > 1e-12;
   const double c = ok ? -e[2] / e[1] : kNaN;  // e = −b1·c (eq. 21–22)
-  p.identified = ok && std::isfinite(c);
+  // plausibility (eq. 18): the guesses lie outside the deadzone, c_l* < c < c_r*
+  p.identified = ok && std::isfinite(c) && c > cfg_.guess_left && c < cfg_.guess_right;
   if (p.identified) {
     p.a1 = e[0];
     p.b1 = e[1];
@@ -230,6 +231,17 @@ void DeadzoneDeadbandEstimator::refresh(int side) noexcept {
     c = (-(1.0 + em[0]) * ep[2] - (1.0 + ep[0]) * em[2]) * inv;
   }
   ok = ok && std::isfinite(c) && std::isfinite(d) && std::isfinite(a1) && std::isfinite(b1);
+  // plausibility from the method's own premise (eq. 18): the guesses lie outside the deadzone,
+  // c_l* < c < c_r*, and a deadband half-width is not negative. An estimate outside that is a
+  // transient of a key that has not converged yet, reported as "not identified".
+  ok = ok && c > cfg_.guess_left && c < cfg_.guess_right && d >= 0.0;
+  // settled: (c, d) stopped moving (see EstimatorConfig::settle_tol)
+  const bool still = std::fabs(c - prev_c_[side]) + std::fabs(d - prev_d_[side]) <=
+                     cfg_.settle_tol * (std::fabs(c) + std::fabs(d));
+  settled_[side] = still ? settled_[side] + 1 : 0;
+  prev_c_[side] = c;
+  prev_d_[side] = d;
+  ok = ok && settled_[side] >= cfg_.settle_updates;
   sa1_[side] = a1;
   sb1_[side] = b1;
   if (ok) {

@@ -2,7 +2,7 @@
 """RLS with lambda = 1 and a large P0 agrees with statsmodels RecursiveLS on the same
 regression to 1e-6 relative, at the end and along the way (every 500 samples).
 
-Data: a first-order plant y(k) = 0.9 y(k-1) + 0.5 v(k-1) + 3 + noise with a seeded random
+Data: a first-order plant y(k) = 0.9 y(k-1) + 0.5 v(k-1) + 150 + noise (c = -e/b1 = -300, between the guesses -1e9 and -250 as eq. 18 requires) with a seeded random
 input. `lash estimate --model input-deadzone` with guess_right below every input, so every
 sample updates the right key: the regression is phi = [-y(k-1), v(k-1), 1] -> [a1, b1, e],
 the thesis's 3-parameter RLS (eq. 13-16); lash reports c = -e/b1, converted back here."""
@@ -23,7 +23,7 @@ dt = 0.01
 v = 100.0 + 50.0 * rng.standard_normal(n)      # always above the guess -> every sample updates 'right'
 y = np.zeros(n)
 for k in range(1, n):
-    y[k] = 0.9 * y[k - 1] + 0.5 * v[k - 1] + 3.0
+    y[k] = 0.9 * y[k - 1] + 0.5 * v[k - 1] + 150.0
 y_meas = y + 2.0 * rng.standard_normal(n)      # measurement noise: LS is not exact, so the comparison is real
 
 fail = 0
@@ -35,7 +35,7 @@ with tempfile.TemporaryDirectory() as d:
             f.write(f"{k * dt!r},{v[k]!r},{y_meas[k]!r}\n")
     trace = os.path.join(d, "trace.csv")
     out = subprocess.run([LASH, "estimate", "--model", "input-deadzone", "--guess-left", "-1e9", "--guess-right",
-                          "-1e6", "--lambda", "1", "--p0", "1e6", "--min-updates", "1", data, "--json", "-o", trace],
+                          "-250", "--lambda", "1", "--p0", "1e6", "--min-updates", "1", data, "--json", "-o", trace],
                          check=True, capture_output=True, text=True).stdout
     j = json.loads(out)
     with open(trace) as f:

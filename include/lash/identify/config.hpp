@@ -82,6 +82,11 @@ struct EstimatorConfig {
   /// one regime (then the filtered v and y obey the same linear relation exactly).
   std::uint32_t direction_run = 2;
   std::uint64_t min_updates = 50;  ///< a key needs this many updates before its side is identified
+  /// deadzone-deadband: a side counts as identified only after (c, d) moved by at most
+  /// settle_tol·(|c| + |d|) per update for settle_updates updates in a row (the 2×2 solve of
+  /// eq. 31/32 amplifies a key that has not converged yet; this keeps such transients out).
+  double settle_tol = 0.01;
+  std::uint32_t settle_updates = 5;
   double singular_tol = 1e-6;      ///< eq. 31/32: |det| below tol·(|a|+|b|) terms counts as singular
   double zero_threshold = 0.0;     ///< output-deadzone: |y| ≤ this counts as 0 [y unit]
   double accel_limit = std::numeric_limits<double>::infinity();  ///< coupled-carts stage 1: max |ÿ| [y unit/s²]

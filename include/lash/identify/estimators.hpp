@@ -217,6 +217,8 @@ class DeadzoneDeadbandEstimator {
   std::array<std::uint64_t, 4> count_{};
   std::array<SideParams, 2> p_{};
   std::array<double, 2> sa1_{}, sb1_{}, sc_{}, sd_{};
+  std::array<double, 2> prev_c_{}, prev_d_{};
+  std::array<std::uint32_t, 2> settled_{};
   detail::History hist_;
   double y1_ = 0.0, v1_ = 0.0, vraw1_ = 0.0, w_ = 0.0;
   int dir1_ = 0, last_ = 0, sim_last_ = 0, side1_ = -1;
