@@ -32,6 +32,8 @@ Command add_tune(CLI::App& app);
 Command add_identify_steps(CLI::App& app);
 Command add_estimate(CLI::App& app);
 Command add_sweep(CLI::App& app);
+/// `lash demo` part of the sweep: runs the E3 campaigns (thesis and lash settings) and prints their summaries.
+int demo_e3_campaign(const std::string& out_dir);
 Command add_can(CLI::App& app);
 Command add_hil(CLI::App& app);
 

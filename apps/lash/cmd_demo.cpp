@@ -125,6 +125,7 @@ int run(const DemoOptions& o) {
     fmt::print("{:8.2f} {:10.3f} {:12.4f} {:12.4f} {:12.4f}\n", t[k], tr.col("v")[k], tr.col("x1_deadzone")[k],
                tr.col("x2_linear")[k], tr.col("y")[k]);
   fmt::print("wrote {} and {}\n", csv, png);
+  demo_e3_campaign(o.out_dir);
   identification_tables(source_dir() + "/config/scenarios");
   e2_comparison(source_dir() + "/config/scenarios");
   return kExitOk;

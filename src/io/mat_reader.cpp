@@ -7,6 +7,8 @@
 
 #include <matio.h>
 
+#include "lash/identify/data.hpp"
+#include "lash/io/csv.hpp"
 #include "lash/io/error.hpp"
 #include "lash/io/mat.hpp"
 
@@ -74,7 +76,75 @@ std::vector<double> read_numeric(mat_t* mat, const std::string& file, const std:
   return out;
 }
 
+/// One column: a variable or a product/quotient expression of variables, numbers and diff(x).
+std::vector<double> read_column(mat_t* mat, const std::string& file, const std::string& spec, bool& is_scalar) {
+  const bool plain = spec.find_first_of("*/()") == std::string::npos;
+  if (plain) return read_numeric(mat, file, spec, is_scalar);
+  std::vector<double> acc{1.0};
+  bool acc_scalar = true;
+  std::size_t pos = 0;
+  char op = '*';
+  while (pos <= spec.size()) {
+    std::size_t end = spec.find_first_of("*/", pos);
+    if (end == std::string::npos) end = spec.size();
+    std::string f = spec.substr(pos, end - pos);
+    while (!f.empty() && f.front() == ' ') f.erase(f.begin());
+    while (!f.empty() && f.back() == ' ') f.pop_back();
+    if (f.empty()) throw InputError(file, 0, spec, "empty factor in column expression '" + spec + "'");
+    std::vector<double> x;
+    bool sc = true;
+    double num = 0.0;
+    if (parse_double(f, num)) {
+      x = {num};
+    } else if (f.rfind("diff(", 0) == 0 && f.back() == ')') {
+      const std::string var = f.substr(5, f.size() - 6);
+      x = read_numeric(mat, file, var, sc);
+      if (sc) throw InputError(file, 0, spec, "diff() needs a vector, '" + var + "' is a scalar");
+      for (std::size_t i = x.size() - 1; i > 0; --i) x[i] -= x[i - 1];
+      x[0] = 0.0;
+    } else {
+      if (f.find_first_of("()") != std::string::npos)
+        throw InputError(file, 0, spec, "unknown function in '" + f + "' (only diff(variable) is known)");
+      x = read_numeric(mat, file, f, sc);
+    }
+    if (op == '/') {
+      for (double& v : x) {
+        if (v == 0.0) throw InputError(file, 0, spec, "division by zero in column expression");
+        v = 1.0 / v;
+      }
+    }
+    if (!sc && !acc_scalar && x.size() != acc.size())
+      throw InputError(file, 0, spec, "vectors of different lengths in column expression");
+    if (acc_scalar && !sc) {
+      const double a = acc[0];
+      acc = x;
+      for (double& v : acc) v *= a;
+      acc_scalar = false;
+    } else if (sc) {
+      for (double& v : acc) v *= x[0];
+    } else {
+      for (std::size_t i = 0; i < acc.size(); ++i) acc[i] *= x[i];
+    }
+    if (end == spec.size()) break;
+    op = spec[end];
+    pos = end + 1;
+  }
+  is_scalar = acc_scalar;
+  return acc;
+}
+
 }  // namespace
+
+void register_mat_reader() {
+  register_column_reader(".mat", [](const std::filesystem::path& path, const std::vector<std::string>& names) {
+    CsvTable t = read_mat(path, names);
+    ColumnData d;
+    d.file = t.file;
+    d.names = std::move(t.header);
+    d.cols = std::move(t.cols);
+    return d;
+  });
+}
 
 bool is_mat_file(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
@@ -103,7 +173,7 @@ CsvTable read_mat(const std::filesystem::path& path, const std::vector<std::stri
   std::string n_from;
   for (std::size_t i = 0; i < variables.size(); ++i) {
     bool s = false;
-    t.cols.push_back(read_numeric(mat.get(), file, variables[i], s));
+    t.cols.push_back(read_column(mat.get(), file, variables[i], s));
     t.header.push_back(variables[i]);
     scalar[i] = s;
     if (!s) {

@@ -25,6 +25,8 @@ std::vector<double> nonempty_numbers(TomlTable& t, const char* key, bool positiv
   return v;
 }
 
+/// The `[estimator]` table, laid out like `lash estimate --config` files (docs/identification.md):
+/// model-level keys at the top, `[estimator.rls]` and `[estimator.noise]` below.
 void read_estimator(TomlTable& t, EstimatorConfig& e) {
   if (auto m = t.string_opt("model")) {
     try {
@@ -33,32 +35,6 @@ void read_estimator(TomlTable& t, EstimatorConfig& e) {
       t.fail("model", ex.what());
     }
   }
-  auto& r = e.rls;
-  r.lambda = t.number_or("lambda", r.lambda);
-  r.p0 = t.number_or("p0", r.p0);
-  if (auto v = t.numbers_opt("eta0")) {
-    if (v->size() != 3 && v->size() != 2) t.fail("eta0", "needs 3 values [a1, b1, e] (2 for the linear model)");
-    for (std::size_t i = 0; i < v->size(); ++i) r.eta0[i] = (*v)[i];
-  }
-  if (auto f = t.string_opt("forgetting")) {
-    if (*f == "exponential") r.forgetting = Forgetting::exponential;
-    else if (*f == "directional") r.forgetting = Forgetting::directional;
-    else t.fail("forgetting", "expected \"exponential\" or \"directional\"");
-  }
-  r.trace_max = t.number_or("trace_max", r.trace_max);
-  auto bounds = [&](const char* key, std::array<double, 3>& out) {
-    if (auto v = t.numbers_opt(key)) {
-      if (v->size() != 3) t.fail(key, "needs 3 values [a1, b1, e]");
-      for (std::size_t i = 0; i < 3; ++i) out[i] = (*v)[i];
-    }
-  };
-  bounds("lower", r.lower);
-  bounds("upper", r.upper);
-  if (auto g = t.numbers_opt("guesses")) {
-    if (g->size() != 2 || !((*g)[0] < (*g)[1])) t.fail("guesses", "needs [c_l*, c_r*] with c_l* < c_r*");
-    e.guess_left = (*g)[0];
-    e.guess_right = (*g)[1];
-  }
   if (auto m = t.string_opt("method")) {
     try {
       e.method = parse_method(*m);
@@ -66,27 +42,53 @@ void read_estimator(TomlTable& t, EstimatorConfig& e) {
       t.fail("method", ex.what());
     }
   }
-  auto count = [&](const char* key, auto& field) {
-    if (auto v = t.integer_opt(key)) {
-      if (*v < 0) t.fail(key, "must be >= 0");
+  e.guess_left = t.number_or("guess_left", e.guess_left);
+  e.guess_right = t.number_or("guess_right", e.guess_right);
+  auto count = [](TomlTable& tt, const char* key, auto& field) {
+    if (auto v = tt.integer_opt(key)) {
+      if (*v < 0) tt.fail(key, "must be >= 0");
       field = static_cast<std::remove_reference_t<decltype(field)>>(*v);
     }
   };
-  count("iv_delay", e.iv_delay);
-  count("min_updates", e.min_updates);
+  count(t, "iv_delay", e.iv_delay);
+  count(t, "min_updates", e.min_updates);
   if (auto b = t.boolean_opt("pooled")) e.pooled = *b;
+  if (auto b = t.boolean_opt("sim_side_by_sign")) e.sim_side_by_sign = *b;
   e.singular_tol = t.number_or("singular_tol", e.singular_tol);
   e.zero_threshold = t.number_or("zero_threshold", e.zero_threshold);
   e.accel_limit = t.number_or("accel_limit", e.accel_limit);
-  e.stage2_start_s = t.number_or("stage2_start_s", e.stage2_start_s);
-  if (auto b = t.boolean_opt("sim_side_by_sign")) e.sim_side_by_sign = *b;
-  auto& n = e.noise;
-  count("filter_length", n.filter_length);
-  if (auto b = t.boolean_opt("filter_input")) n.filter_input = *b;
-  count("input_delay", n.input_delay);
-  count("derivative_filter_length", n.derivative_filter_length);
-  n.derivative_threshold = t.number_or("derivative_threshold", n.derivative_threshold);
-  count("align_delay", n.align_delay);
+  e.stage2_start_s = t.number_or("stage2_start", e.stage2_start_s);
+  if (auto rt = t.table_opt("rls")) {
+    auto& r = e.rls;
+    r.lambda = rt->number_or("lambda", r.lambda);
+    r.p0 = rt->number_or("p0", r.p0);
+    auto triple = [&](const char* key, std::array<double, 3>& out) {
+      if (auto v = rt->numbers_opt(key)) {
+        if (v->size() != 3) rt->fail(key, "expected 3 numbers [a1, b1, e]");
+        for (std::size_t i = 0; i < 3; ++i) out[i] = (*v)[i];
+      }
+    };
+    triple("eta0", r.eta0);
+    triple("lower", r.lower);
+    triple("upper", r.upper);
+    r.trace_max = rt->number_or("trace_max", r.trace_max);
+    if (auto f = rt->string_opt("forgetting")) {
+      if (*f == "exponential") r.forgetting = Forgetting::exponential;
+      else if (*f == "directional") r.forgetting = Forgetting::directional;
+      else rt->fail("forgetting", "expected \"exponential\" or \"directional\"");
+    }
+    rt->finish();
+  }
+  if (auto nt = t.table_opt("noise")) {
+    auto& n = e.noise;
+    count(*nt, "filter_length", n.filter_length);
+    if (auto b = nt->boolean_opt("filter_input")) n.filter_input = *b;
+    count(*nt, "input_delay", n.input_delay);
+    count(*nt, "derivative_filter_length", n.derivative_filter_length);
+    n.derivative_threshold = nt->number_or("derivative_threshold", n.derivative_threshold);
+    count(*nt, "align_delay", n.align_delay);
+    nt->finish();
+  }
   t.finish();
   try {
     e.validate();

@@ -205,12 +205,14 @@ RunResult run_one(const Campaign& c, const RunSpec& r) {
       rigs::CoupledCarts rig(c.rig.coupled_carts, c.dt_s, r.seed);
       // The estimator sees the free cart's position; the score is on its velocity.
       auto pos_vel = [](const rigs::CoupledCartsSample& s) { return std::pair<double, double>{s.position_m, s.velocity_m_s}; };
-      // The model's free-cart velocity: backward difference of its simulated position (eq. 41).
+      // The model's free-cart velocity (eq. 41): the simulated motor-cart velocity ŵ̇ while the
+      // simulated free cart moves (its position changed this sample), 0 inside the deadband.
+      // Not the raw difference of the simulated position: that also carries the jumps of the
+      // stage-2 offset estimate (thesis §1.6.3: "a spike in the velocity ... at 7.5 s").
       double last_pos = 0.0;
-      const double inv_dt = 1.0 / c.dt_s;
-      auto sim_vel = [&last_pos, inv_dt](const CoupledCartsEstimator& e) {
+      auto sim_vel = [&last_pos](const CoupledCartsEstimator& e) {
         const double p = e.simulated();
-        const double vel = (p - last_pos) * inv_dt;
+        const double vel = p != last_pos ? e.simulated_velocity() : 0.0;
         last_pos = p;
         return vel;
       };

@@ -27,7 +27,7 @@ check neg_duration     "neg_duration.toml:4: 'duration_s'.*> 0"                 
 check zero_dt          "zero_dt.toml:3: 'dt_s'.*> 0"                            $'name = "t"\nrig = "motor_cart"\ndt_s = 0\nduration_s = 1.0\n'"$matrix"
 check unknown_rig      "unknown_rig.toml:2: 'rig'.*unknown rig"                 $'name = "t"\nrig = "tractor"\ndt_s = 0.001\nduration_s = 1.0\n'"$matrix"
 check bad_waveform     "bad_waveform.toml:6: 'matrix.waveforms'.*sawtooth"      "${head}"$'[matrix]\nwaveforms = ["sawtooth"]\namplitudes = [1.0]\nfrequencies_rad_s = [2.0]\nrepeats = 1\n'
-check bad_lambda       "bad_lambda.toml:[0-9]+: 'estimator'.*lambda"              "${head}${matrix}"$'[estimator]\nlambda = 1.5\n'
+check bad_lambda       "bad_lambda.toml:[0-9]+: 'estimator'.*lambda"              "${head}${matrix}"$'[estimator]\nmodel = "output-deadzone"\n[estimator.rls]\nlambda = 1.5\n'
 check bad_rig_value    "bad_rig_value.toml:[0-9]+: 'rig_params'.*mass_kg"         "${head}${matrix}"$'[rig_params]\nmass_kg = -1.0\n'
 check bad_model        "bad_model.toml:[0-9]+: 'estimator.model'"                 "${head}${matrix}"$'[estimator]\nmodel = "quadratic"\n'
 out=$("$LASH" sweep "$d/nope.toml" -q -o "$d/x.csv" 2>&1); rc=$?

@@ -27,46 +27,46 @@ MotorCartParams quiet_cart() {
 
 TEST(MotorCart, DerivedConstantsByHand) {
   const MotorCartParams p;
-  // α = K_t·G/(r·R) = 0.05·4/(0.02·2) = 5 N/V; β = (0.05·4/0.02)²/2 = 50 N·s/m; B = 55 N·s/m.
-  EXPECT_DOUBLE_EQ(p.force_per_volt(), 5.0);
-  EXPECT_NEAR(p.emf_damping(), 50.0, 1e-12);
-  EXPECT_NEAR(p.total_damping(), 55.0, 1e-12);
-  // m_eff = 7.35 + 1e-5·(4/0.02)² = 7.75 kg.
-  EXPECT_NEAR(p.effective_mass(), 7.75, 1e-12);
+  // α = K_t·G/(r·R) = 0.05·8/(0.02·2) = 10 N/V; β = (0.05·8/0.02)²/2 = 200 N·s/m; B = 205 N·s/m.
+  EXPECT_DOUBLE_EQ(p.force_per_volt(), 10.0);
+  EXPECT_NEAR(p.emf_damping(), 200.0, 1e-12);
+  EXPECT_NEAR(p.total_damping(), 205.0, 1e-12);
+  // m_eff = 7.35 + 1e-5·(8/0.02)² = 8.95 kg.
+  EXPECT_NEAR(p.effective_mass(), 8.95, 1e-12);
   const EffectiveModel m = p.effective(0.001);
-  EXPECT_NEAR(m.side.right.tau_s, 7.75 / 55.0, 1e-12);
-  EXPECT_NEAR(m.side.right.gain, 5.0 / 55.0, 1e-12);
-  EXPECT_NEAR(m.side.right.c, 5.0 / 55.0, 1e-12);
-  EXPECT_NEAR(m.side.left.c, -5.5 / 55.0, 1e-12);
-  EXPECT_NEAR(m.side.right.a1, -std::exp(-0.001 * 55.0 / 7.75), 1e-15);
-  // Encoder: 2π·0.02/(4·4000) m per count.
-  EXPECT_NEAR(p.encoder_step_m(), 2.0 * M_PI * 0.02 / 16000.0, 1e-18);
+  EXPECT_NEAR(m.side.right.tau_s, 8.95 / 205.0, 1e-12);
+  EXPECT_NEAR(m.side.right.gain, 10.0 / 205.0, 1e-12);
+  EXPECT_NEAR(m.side.right.c, 4.0 / 205.0, 1e-12);
+  EXPECT_NEAR(m.side.left.c, -4.4 / 205.0, 1e-12);
+  EXPECT_NEAR(m.side.right.a1, -std::exp(-0.001 * 205.0 / 8.95), 1e-15);
+  // Encoder: 2π·0.02/(8·8000) m per count.
+  EXPECT_NEAR(p.encoder_step_m(), 2.0 * M_PI * 0.02 / 64000.0, 1e-18);
 }
 
 TEST(MotorCart, SteadyVelocityIsForceBalance) {
   MotorCart cart(quiet_cart(), 0.001, 7);
   for (int k = 0; k < 3000; ++k) cart.step(6.0);
-  // (α·V − F_c+)/B = (30 − 5)/55.
-  EXPECT_NEAR(cart.true_velocity_m_s(), 25.0 / 55.0, 1e-6);
+  // (α·V − F_c+)/B = (60 − 4)/205.
+  EXPECT_NEAR(cart.true_velocity_m_s(), 56.0 / 205.0, 1e-6);
   for (int k = 0; k < 3000; ++k) cart.step(-6.0);
-  EXPECT_NEAR(cart.true_velocity_m_s(), -(30.0 - 5.5) / 55.0, 1e-6);
+  EXPECT_NEAR(cart.true_velocity_m_s(), -(60.0 - 4.4) / 205.0, 1e-6);
 }
 
 TEST(MotorCart, StictionHoldsBelowBreakAway) {
-  // Break-away force 1.3·5 N = 6.5 N ↔ 1.3 V; at 1.25 V (6.25 N) the cart never moves …
+  // Break-away force 1.3·4 N = 5.2 N ↔ 0.52 V; at 0.5 V (5 N) the cart never moves …
   MotorCart still(quiet_cart(), 0.001, 1);
-  for (int k = 0; k < 2000; ++k) still.step(1.25);
+  for (int k = 0; k < 2000; ++k) still.step(0.5);
   EXPECT_EQ(still.true_velocity_m_s(), 0.0);
   EXPECT_EQ(still.true_position_m(), 0.0);
-  // … at 1.35 V (6.75 N) it breaks away and settles at (6.75 − 5)/55 m/s.
+  // … at 0.55 V (5.5 N) it breaks away and settles at (5.5 − 4)/205 m/s.
   MotorCart moving(quiet_cart(), 0.001, 1);
-  for (int k = 0; k < 3000; ++k) moving.step(1.35);
-  EXPECT_NEAR(moving.true_velocity_m_s(), 1.75 / 55.0, 1e-6);
-  // Between kinetic and break-away level a moving cart keeps moving (5 N < 6 N < 6.5 N).
-  for (int k = 0; k < 3000; ++k) moving.step(1.2);
-  EXPECT_NEAR(moving.true_velocity_m_s(), 1.0 / 55.0, 1e-6);
+  for (int k = 0; k < 3000; ++k) moving.step(0.55);
+  EXPECT_NEAR(moving.true_velocity_m_s(), 1.5 / 205.0, 1e-6);
+  // Between kinetic and break-away level a moving cart keeps moving (4 N < 4.5 N < 5.2 N).
+  for (int k = 0; k < 3000; ++k) moving.step(0.45);
+  EXPECT_NEAR(moving.true_velocity_m_s(), 0.5 / 205.0, 1e-6);
   // Below the kinetic level it stops and stays stopped.
-  for (int k = 0; k < 3000; ++k) moving.step(0.9);
+  for (int k = 0; k < 3000; ++k) moving.step(0.35);
   EXPECT_EQ(moving.true_velocity_m_s(), 0.0);
 }
 
@@ -209,9 +209,9 @@ TEST(CoupledCarts, PushesAtFullVelocityThenWaitsInTheSlot) {
   p.motor.friction_ripple = 0.0;
   CoupledCarts rig(p, 0.001, 2);
   for (int k = 0; k < 4000; ++k) rig.step(6.0);
-  // Pushing: one body, (α·V − F_c1 − F_f2)/B = (30 − 5 − 2.5)/55.
-  EXPECT_NEAR(rig.motor_velocity_m_s(), 22.5 / 55.0, 1e-6);
-  EXPECT_NEAR(rig.free_velocity_m_s(), 22.5 / 55.0, 1e-6);
+  // Pushing: one body, (α·V − F_c1 − F_f2)/B = (60 − 4 − 2.5)/205.
+  EXPECT_NEAR(rig.motor_velocity_m_s(), 53.5 / 205.0, 1e-6);
+  EXPECT_NEAR(rig.free_velocity_m_s(), 53.5 / 205.0, 1e-6);
   EXPECT_NEAR(rig.motor_position_m() - rig.free_position_m(), p.half_clearance_m, 1e-9);
   // Reverse: the free cart stops (bearing friction) while the pin crosses the slot, 2d.
   const double x2_before = rig.free_position_m();
@@ -225,9 +225,9 @@ TEST(CoupledCarts, PushesAtFullVelocityThenWaitsInTheSlot) {
     }
   }
   ASSERT_LT(k, 4000);
-  // Coasting from 0.409 m/s at 2.5/0.42 m/s² takes v²/(2a) = 14.1 mm < 2d, plus at most one
-  // sample period (0.4 mm) of pushing before the pin lets go.
-  const double v0 = 22.5 / 55.0, a = 2.5 / 0.42;
+  // Coasting from 0.261 m/s at 2.5/0.42 m/s² takes v²/(2a) = 5.7 mm < 2d = 10 mm, plus at most one
+  // sample period (0.26 mm) of pushing before the pin lets go.
+  const double v0 = 53.5 / 205.0, a = 2.5 / 0.42;
   EXPECT_LE(x2_stop - x2_before, v0 * v0 / (2 * a) + v0 * 0.001);
   EXPECT_GE(x2_stop - x2_before, v0 * v0 / (2 * a) - 5e-6);
   // It then waits while the pin crosses the slot …
@@ -237,7 +237,7 @@ TEST(CoupledCarts, PushesAtFullVelocityThenWaitsInTheSlot) {
   }
   // … and is pulled along at (α·V − F_c1− − F_f2)/B.
   for (k = 0; k < 4000; ++k) rig.step(-6.0);
-  EXPECT_NEAR(rig.free_velocity_m_s(), -(30 - 5.5 - 2.5) / 55.0, 1e-6);
+  EXPECT_NEAR(rig.free_velocity_m_s(), -(60 - 4.4 - 2.5) / 205.0, 1e-6);
   EXPECT_NEAR(rig.free_position_m() - rig.motor_position_m(), p.half_clearance_m, 1e-9);
   EXPECT_GT(rig.impacts(), 0);
 }

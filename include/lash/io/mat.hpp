@@ -17,6 +17,12 @@ namespace lash {
 std::vector<std::string> mat_variable_names(const std::filesystem::path& path);
 
 /// Reads the named numeric variables (real; any MATLAB numeric or logical class) as columns.
+/// A name may also be a small expression over variables, so a recipe can derive its signals
+/// without a conversion step (the column keeps the expression as its name):
+///   product  = factor ('*' factor | '/' factor)*
+///   factor   = variable | number | 'diff(' variable ')'
+/// where diff(x) is the backward difference x(k) − x(k−1) with diff(x)(0) = 0. Example (EMPS,
+/// docs/emps.md): "gtau*vir" is the drive force [N], "diff(qm)/0.001" the velocity [m/s].
 /// Each must be a vector (N×1 or 1×N) of one common length N, or a scalar (1×1), which is
 /// repeated N times. At least one must be a vector. Every value must be finite.
 /// Errors (missing file, missing variable, wrong shape/class, length mismatch, non-finite
@@ -26,6 +32,10 @@ CsvTable read_mat(const std::filesystem::path& path, const std::vector<std::stri
 
 /// Reads one real scalar (1×1) variable; InputError if absent or not a scalar.
 double read_mat_scalar(const std::filesystem::path& path, const std::string& variable);
+
+/// Registers read_mat as the reader of ".mat" files for lash::load_columns (identify/data.hpp),
+/// so `lash estimate` and every other record reader accept MAT files. Idempotent.
+void register_mat_reader();
 
 /// True if `path` ends in ".mat" (any case): the commands use it to pick the reader.
 bool is_mat_file(const std::filesystem::path& path);

@@ -25,10 +25,10 @@ struct CoupledCartsParams {
   double free_mass_kg = 0.42;           ///< free cart mass [kg] (thesis §1.6.3)
   double free_coulomb_N = 2.5;          ///< free cart bearing friction, kinetic [N] (μ ≈ 0.6: braked bearings)
   double free_static_N = 3.0;           ///< free cart bearing friction, break-away [N]
-  double half_clearance_m = 0.010;      ///< d: half of (slot length − pin diameter) [m]
+  double half_clearance_m = 0.005;      ///< d: half of (slot length − pin diameter) [m]
   double restitution = 0.3;             ///< pin–slot coefficient of restitution [-]
   double lock_speed_m_s = 0.01;         ///< approach speeds below this end in contact (no bounce) [m/s]
-  double free_encoder_step_m = 5e-6;    ///< free cart linear encoder resolution [m]
+  double free_encoder_step_m = 1e-7;    ///< free cart linear encoder resolution (interpolated optical scale) [m]
 
   /// Throws std::invalid_argument naming the first bad parameter.
   void validate() const;

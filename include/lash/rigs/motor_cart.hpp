@@ -47,20 +47,20 @@ struct MotorCartParams {
   double inductance_H = 2.0e-3;         ///< armature inductance L [H] (τ_e = L/R = 1 ms)
   double torque_constant_Nm_A = 0.05;   ///< K_t [N·m/A] = back-EMF constant K_e [V·s/rad] in SI
   double rotor_inertia_kgm2 = 1.0e-5;   ///< J_m [kg·m²], reflected to the cart as J_m·G²/r²
-  double gear_ratio = 4.0;              ///< G = motor angle / pinion angle [-]
+  double gear_ratio = 8.0;              ///< G = motor angle / pinion angle [-]
   double pinion_radius_m = 0.02;        ///< r [m]: cart travel per pinion radian
   // cart
   double mass_kg = 7.35;                ///< cart mass m [kg] (thesis §1.6.3: 7.35 kg)
   double viscous_Ns_m = 5.0;            ///< viscous friction b [N·s/m]
-  double coulomb_right_N = 5.0;         ///< kinetic Coulomb friction moving forward F_c+ [N]
-  double coulomb_left_N = 5.5;          ///< kinetic Coulomb friction moving backward F_c− [N]
+  double coulomb_right_N = 4.0;         ///< kinetic Coulomb friction moving forward F_c+ [N]
+  double coulomb_left_N = 4.4;          ///< kinetic Coulomb friction moving backward F_c− [N]
   double breakaway_ratio = 1.3;         ///< static / kinetic friction F_s/F_c [-] (stiction)
   double friction_ripple = 0.05;        ///< relative ripple of F_c along the track (rail joints, wear) [-]
   double friction_ripple_period_m = 0.05; ///< spatial period of that ripple [m]; phase random per seed
   // amplifier
   double voltage_noise_V = 0.02;        ///< σ of the power amplifier's output noise, per sample [V]
   // sensing
-  double encoder_counts_per_rev = 4000; ///< quadrature counts per motor revolution [-]
+  double encoder_counts_per_rev = 8000; ///< quadrature counts per motor revolution (2000 lines × 4) [-]
   int substeps = 10;                    ///< internal steps per sample period [-]
 
   /// Throws std::invalid_argument naming the first parameter that is not finite and positive
