@@ -302,17 +302,15 @@ class Parser {
         d.object = o.text;
       }
       d.name = string("the attribute name");
-      const std::size_t b = tok_.begin;
       if (tok_.kind != Tok::ident) fail(tok_, "expected the attribute type (INT, HEX, FLOAT, STRING, ENUM)");
       const std::string type = tok_.text;
       if (type != "INT" && type != "HEX" && type != "FLOAT" && type != "STRING" && type != "ENUM")
         fail(tok_, "unknown attribute type '" + type + "'");
-      std::size_t e = b;
+      std::size_t prev_end = tok_.begin;
       while (tok_.kind != Tok::end && !(tok_.kind == Tok::punct && tok_.text[0] == ';')) {
-        e = tok_.end;
+        append_token(d.type, tok_, prev_end);
         take();
       }
-      d.type = normalize_space(lex_.slice(b, e));
       expect_end();
       db_.attribute_definitions.push_back(std::move(d));
     } else if (k == "BA_DEF_DEF_") {
@@ -367,34 +365,25 @@ class Parser {
     }
   }
 
-  static std::string normalize_space(std::string_view s) {
-    std::string out;
-    bool space = false;
-    bool in_string = false;
-    for (char c : s) {
-      if (c == '"') in_string = !in_string;
-      if (!in_string && (c == ' ' || c == '\t' || c == '\r' || c == '\n')) {
-        space = true;
-        continue;
-      }
-      if (space && !out.empty()) out.push_back(' ');
-      space = false;
-      out.push_back(c);
-    }
-    return out;
+  /// Appends a token's source text; one blank where the source had blanks or comments.
+  void append_token(std::string& out, const Token& t, std::size_t& prev_end) const {
+    if (!out.empty() && t.begin > prev_end) out.push_back(' ');
+    out += lex_.slice(t.begin, t.end);
+    prev_end = t.end;
   }
 
   /// Skips to the statement's ';' (lexing, so strings may hold ';') and keeps the text.
   void other_from(const Token& kw) {
-    std::size_t e = kw.end;
+    std::string text(lex_.slice(kw.begin, kw.end));
+    std::size_t prev_end = kw.end;
     while (tok_.kind != Tok::end && !(tok_.kind == Tok::punct && tok_.text[0] == ';')) {
-      e = tok_.end;
+      append_token(text, tok_, prev_end);
       take();
     }
     if (tok_.kind == Tok::end) fail(tok_, "missing ';' to end " + kw.text);
-    e = tok_.end;
+    append_token(text, tok_, prev_end);
     take();
-    db_.other_statements.push_back(normalize_space(lex_.slice(kw.begin, e)));
+    db_.other_statements.push_back(std::move(text));
   }
 
   std::vector<ValueDescription> value_list() {

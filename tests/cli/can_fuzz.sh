@@ -19,7 +19,11 @@ fi
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 cd "$work"
+# libFuzzer's default error exit code is 77, which ctest would read as "skipped": use 1.
+artifacts="$clang_dir/fuzz-artifacts/$name"
+mkdir -p "$artifacts"
 "$bin" -max_total_time="$secs" -timeout=10 -rss_limit_mb=2048 -max_len=65536 -print_final_stats=1 \
+  -error_exitcode=1 -timeout_exitcode=1 -artifact_prefix="$artifacts/" \
   "$work" "$src/fuzz/corpus/$name" 2>&1 | tail -n 25
 rc=${PIPESTATUS[0]}
 exit "$rc"
