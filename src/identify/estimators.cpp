@@ -192,8 +192,8 @@ std::uint64_t DeadzoneDeadbandEstimator::skipped() const noexcept {
   return n;
 }
 
-void DeadzoneDeadbandEstimator::refresh(int side) noexcept {
-  SideParams& p = p_[side];
+SideParams DeadzoneDeadbandEstimator::derive(int side) const noexcept {
+  SideParams p;
   const std::uint64_t np = count_[side * 2], nm = count_[side * 2 + 1];
   double a1, b1, c, d;
   bool ok = np >= cfg_.min_updates && nm >= cfg_.min_updates;
@@ -235,26 +235,37 @@ void DeadzoneDeadbandEstimator::refresh(int side) noexcept {
   // c_l* < c < c_r*, and a deadband half-width is not negative. An estimate outside that is a
   // transient of a key that has not converged yet, reported as "not identified".
   ok = ok && c > cfg_.guess_left && c < cfg_.guess_right && d >= 0.0;
-  // settled: (c, d) stopped moving (see EstimatorConfig::settle_tol)
-  const bool still = std::fabs(c - prev_c_[side]) + std::fabs(d - prev_d_[side]) <=
-                     cfg_.settle_tol * (std::fabs(c) + std::fabs(d));
+  p.a1 = a1;  // raw values; `identified` tells whether they count
+  p.b1 = b1;
+  p.c = c;
+  p.d = d;
+  p.identified = ok;
+  return p;
+}
+
+void DeadzoneDeadbandEstimator::refresh(int side) noexcept {
+  const SideParams q = derive(side);
+  // settled: (c, d) stopped moving between refreshes (see EstimatorConfig::settle_tol)
+  const bool still = std::fabs(q.c - prev_c_[side]) + std::fabs(q.d - prev_d_[side]) <=
+                     cfg_.settle_tol * (std::fabs(q.c) + std::fabs(q.d));
   settled_[side] = still ? settled_[side] + 1 : 0;
-  prev_c_[side] = c;
-  prev_d_[side] = d;
-  ok = ok && settled_[side] >= cfg_.settle_updates;
-  sa1_[side] = a1;
-  sb1_[side] = b1;
+  prev_c_[side] = q.c;
+  prev_d_[side] = q.d;
+  const bool ok = q.identified && settled_[side] >= cfg_.settle_updates;
+  p_[side].identified = ok;
+  sa1_[side] = q.a1;
+  sb1_[side] = q.b1;
   if (ok) {
-    p.a1 = a1;
-    p.b1 = b1;
-    p.c = c;
-    p.d = d;
-    p.identified = true;
-    sc_[side] = c;
-    sd_[side] = d > 0.0 ? d : 0.0;
-  } else {
-    p = SideParams{};
+    sc_[side] = q.c;
+    sd_[side] = q.d > 0.0 ? q.d : 0.0;
   }
+}
+
+SideParams DeadzoneDeadbandEstimator::params(Side s) const noexcept {
+  const int i = detail::side_index(s);
+  SideParams q = derive(i);  // always current, even between refreshes of the free-run model
+  if (!(q.identified && settled_[i] >= cfg_.settle_updates)) return SideParams{};
+  return q;
 }
 
 double DeadzoneDeadbandEstimator::predict_free(int side, double y1, double v1) const noexcept {

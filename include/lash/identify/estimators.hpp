@@ -167,7 +167,9 @@ class DeadzoneDeadbandEstimator {
           yhat_ = rls_[key].update(phi, s.y);
         count_[key] = rls_[key].updates();
       }
-      refresh(side);
+      // Derived (a1, b1, c, d) are refreshed on every update until the side is identified, then
+      // every 4th update (the free run lags at most 3 samples; params() is always current).
+      if (!p_[side].identified || (++since_[side] & 3u) == 0) refresh(side);
       last_ = side;
     } else {
       yhat_ = predict_free(side >= 0 ? side : last_, y1, v1);
@@ -182,7 +184,8 @@ class DeadzoneDeadbandEstimator {
 
   double prediction() const noexcept { return yhat_; }
   double simulated() const noexcept { return ysim_; }
-  SideParams params(Side s) const noexcept { return p_[detail::side_index(s)]; }
+  /// Current parameters (computed from the four/two RLS on each call).
+  SideParams params(Side s) const noexcept;
   /// Updates of key (side, +) or (side, −).
   std::uint64_t updates(Side s, bool plus) const noexcept {
     return count_[detail::side_index(s) * 2 + (plus ? 0 : 1)];
@@ -195,6 +198,7 @@ class DeadzoneDeadbandEstimator {
   const Rls<4>& pooled_rls(Side s) const noexcept { return pooled_[detail::side_index(s)]; }
 
  private:
+  SideParams derive(int side) const noexcept;
   void refresh(int side) noexcept;
   double predict_free(int side, double y1, double v1) const noexcept;
   void simulate(double v) noexcept {
@@ -219,6 +223,7 @@ class DeadzoneDeadbandEstimator {
   std::array<double, 2> sa1_{}, sb1_{}, sc_{}, sd_{};
   std::array<double, 2> prev_c_{}, prev_d_{};
   std::array<std::uint32_t, 2> settled_{};
+  std::array<std::uint32_t, 2> since_{};
   detail::History hist_;
   double y1_ = 0.0, v1_ = 0.0, vraw1_ = 0.0, w_ = 0.0;
   int dir1_ = 0, last_ = 0, sim_last_ = 0, side1_ = -1;
