@@ -1,5 +1,6 @@
 // BenchLayout::from_dbc: the frame layout read from config/hydraulic_bench.dbc.
 #include <cstdio>
+#include <stdexcept>
 
 #include "lash/can/dbc.hpp"
 #include "lash/hil/bench_layout.hpp"
@@ -29,13 +30,11 @@ struct Reader {
       throw InputError(file, 0, where,
                        "must be " + std::to_string(min_bits) + ".." + std::to_string(max_bits) + " bits long");
     if (s->factor == 0.0) throw InputError(file, 0, where, "factor must not be 0");
-    BitField b;
-    b.start_bit = s->start_bit;
-    b.length = s->length;
-    b.intel = s->byte_order == can::dbc::ByteOrder::intel;
-    b.factor = s->factor;
-    b.offset = s->offset;
-    return b;
+    try {
+      return BitField(*s);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(file, 0, where, e.what());
+    }
   }
 };
 

@@ -1,65 +1,27 @@
 #include "lash/hil/bench_layout.hpp"
 
-#include <cmath>
 
 namespace lash::hil {
 
-void BitField::put(can::Frame& f, std::uint64_t raw) const noexcept {
-  raw &= max_raw();
-  if (intel) {
-    for (std::uint32_t i = 0; i < length; ++i) {
-      const std::uint32_t bit = start_bit + i;
-      if (bit >= 64) return;
-      const auto byte = bit / 8, pos = bit % 8;
-      const auto mask = static_cast<std::uint8_t>(1u << pos);
-      if ((raw >> i) & 1u)
-        f.data[byte] = static_cast<std::uint8_t>(f.data[byte] | mask);
-      else
-        f.data[byte] = static_cast<std::uint8_t>(f.data[byte] & ~mask);
-    }
-  } else {
-    // Motorola: start bit is the MSB; walk down the sawtooth numbering.
-    std::uint32_t bit = start_bit;
-    for (std::uint32_t i = 0; i < length; ++i) {
-      if (bit >= 64) return;
-      const auto byte = bit / 8, pos = bit % 8;
-      const auto mask = static_cast<std::uint8_t>(1u << pos);
-      if ((raw >> (length - 1 - i)) & 1u)
-        f.data[byte] = static_cast<std::uint8_t>(f.data[byte] | mask);
-      else
-        f.data[byte] = static_cast<std::uint8_t>(f.data[byte] & ~mask);
-      bit = (pos == 0) ? bit + 15 : bit - 1;
-    }
-  }
+namespace {
+can::dbc::Signal make_signal(std::uint32_t start_bit, std::uint32_t length, double factor, double lo, double hi,
+                             bool intel) {
+  can::dbc::Signal s;
+  s.name = "field";
+  s.start_bit = start_bit;
+  s.length = length;
+  s.byte_order = intel ? can::dbc::ByteOrder::intel : can::dbc::ByteOrder::motorola;
+  s.factor = factor;
+  s.minimum = lo;
+  s.maximum = hi;
+  return s;
 }
+}  // namespace
 
-std::uint64_t BitField::get(const can::Frame& f) const noexcept {
-  std::uint64_t raw = 0;
-  if (intel) {
-    for (std::uint32_t i = 0; i < length; ++i) {
-      const std::uint32_t bit = start_bit + i;
-      if (bit >= 64) break;
-      if ((f.data[bit / 8] >> (bit % 8)) & 1u) raw |= (1ULL << i);
-    }
-  } else {
-    std::uint32_t bit = start_bit;
-    for (std::uint32_t i = 0; i < length; ++i) {
-      if (bit >= 64) break;
-      const auto pos = bit % 8;
-      raw = (raw << 1) | ((f.data[bit / 8] >> pos) & 1u);
-      bit = (pos == 0) ? bit + 15 : bit - 1;
-    }
-  }
-  return raw;
-}
+BitField::BitField(std::uint32_t start_bit, std::uint32_t length, double factor, double lo, double hi, bool intel)
+    : codec_(make_signal(start_bit, length, factor, lo, hi, intel)) {}
 
-std::uint64_t BitField::to_raw(double physical) const noexcept {
-  const double r = std::round((physical - offset) / factor);
-  if (!(r > 0.0)) return 0;  // also NaN
-  const double top = static_cast<double>(max_raw());
-  if (r >= top) return max_raw();
-  return static_cast<std::uint64_t>(r);
-}
+BitField::BitField(const can::dbc::Signal& signal) : codec_(signal) {}
 
 can::Frame BenchLayout::pack_command(const CommandMsg& m) const noexcept {
   can::Frame f;

@@ -220,7 +220,8 @@ bool MasterNode::step(can::Bus& bus, double now_s) noexcept {
       } else if (++misses_ >= cfg_.fault_missed_periods) {
         state_ = MasterState::fault;
         current_mA_ = 0.0;  // safe state
-        sens_.forget();     // a restarted slave counts from 0 again
+        // No forget(): frames missed now are counted lost when the counter resumes; a restarted
+        // slave (counter back at 0) shows up as a resync.
         last_cro_k_ = k_;
         event(MasterEventKind::sensor_timeout, now_s);
       } else if (!have_measurement_) {

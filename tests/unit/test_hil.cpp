@@ -72,8 +72,8 @@ TEST(HilLayout, CommandBytesByHand) {
   // Clamping: negative → 0, beyond 16 bits → 65535.
   c.solenoid_a_mA = -5.0;
   EXPECT_EQ(L.unpack_command(L.pack_command(c)).solenoid_a_mA, 0.0);
-  c.solenoid_a_mA = 1e9;
-  EXPECT_DOUBLE_EQ(L.unpack_command(L.pack_command(c)).solenoid_a_mA, 65535 * 0.1);
+  c.solenoid_a_mA = 1e9;  // clamped to the DBC range [0|2000] mA
+  EXPECT_DOUBLE_EQ(L.unpack_command(L.pack_command(c)).solenoid_a_mA, 2000.0);
 }
 
 TEST(HilLayout, SensorBytesAndSpecScaling) {
@@ -92,13 +92,29 @@ TEST(HilLayout, SensorBytesAndSpecScaling) {
 
 TEST(HilLayout, MotorolaFieldByHand) {
   // 12-bit big-endian field with MSB at bit 7: occupies byte 0 and the high nibble of byte 1.
-  BitField b{7, 12, false, 1.0, 0.0};
+  BitField b{7, 12, 1.0, 0.0, 0.0, /*intel=*/false};
   can::Frame f;
   f.len = 8;
   b.put(f, 0xABC);
   EXPECT_EQ(f.data[0], 0xAB);
   EXPECT_EQ(f.data[1], 0xC0);
   EXPECT_EQ(b.get(f), 0xABCu);
+}
+
+TEST(HilLayout, ShippedDbcMatchesBuiltInLayout) {
+  const BenchLayout d = BenchLayout::from_dbc(std::string(LASH_SOURCE_DIR) + "/config/hydraulic_bench.dbc");
+  const BenchLayout b;
+  EXPECT_EQ(d.command_id, b.command_id);
+  EXPECT_EQ(d.sensors_id, b.sensors_id);
+  EXPECT_EQ(d.cro_id, b.cro_id);
+  EXPECT_EQ(d.dto_id, b.dto_id);
+  EXPECT_EQ(d.command_len, 8);
+  EXPECT_EQ(d.sensors_len, 6);
+  CommandMsg c{1234.5, 0, 0, 77};
+  SensorMsg s{17343, 0, 9};
+  EXPECT_TRUE(can::same_content(d.pack_command(c), b.pack_command(c)));
+  EXPECT_TRUE(can::same_content(d.pack_sensors(s), b.pack_sensors(s)));
+  EXPECT_TRUE(can::same_content(d.pack_connect(3), b.pack_connect(3)));
 }
 
 TEST(HilLayout, CcpConnect) {

@@ -18,26 +18,39 @@
 #include <cstdint>
 #include <filesystem>
 
+#include "lash/can/codec.hpp"
+#include "lash/can/dbc.hpp"
 #include "lash/can/frame.hpp"
 
 namespace lash::hil {
 
-/// One unsigned bit field of a frame (Intel or Motorola), as the DBC places it.
-struct BitField {
-  std::uint32_t start_bit = 0;  ///< DBC start bit (Intel: LSB; Motorola: MSB, sawtooth numbering)
-  std::uint32_t length = 0;     ///< [bit] 1..64
-  bool intel = true;
-  double factor = 1.0;          ///< physical = raw·factor + offset
-  double offset = 0.0;
+/// One signal of a frame as the DBC places it, coded by the CAN layer's SignalCodec
+/// (can/codec.hpp: Intel/Motorola bit placement, physical → raw rounding to nearest and
+/// clamping to the DBC range). All members are noexcept and O(1).
+class BitField {
+ public:
+  /// An unsigned Intel signal: start bit (LSB), length, factor, physical range [lo, hi]
+  /// (lo == hi: no range). `intel = false` places it Motorola (start bit = MSB).
+  BitField(std::uint32_t start_bit, std::uint32_t length, double factor, double lo = 0.0, double hi = 0.0,
+           bool intel = true);
+  explicit BitField(const can::dbc::Signal& signal);
 
-  void put(can::Frame& f, std::uint64_t raw) const noexcept;
-  std::uint64_t get(const can::Frame& f) const noexcept;
-  std::uint64_t max_raw() const noexcept { return length >= 64 ? ~0ULL : ((1ULL << length) - 1); }
-  /// physical → raw, rounding to nearest and clamping to [0, max_raw].
-  std::uint64_t to_raw(double physical) const noexcept;
-  double to_physical(std::uint64_t raw) const noexcept {
-    return static_cast<double>(raw) * factor + offset;
+  void put(can::Frame& f, std::uint64_t raw) const noexcept {
+    codec_.write_raw({f.data.data(), can::Frame::kMaxClassicLen}, raw);
   }
+  std::uint64_t get(const can::Frame& f) const noexcept {
+    return codec_.read_raw({f.data.data(), can::Frame::kMaxClassicLen}).value_or(0);
+  }
+  /// physical → raw: rounds to nearest, clamps to the DBC range and the bit range.
+  std::uint64_t to_raw(double physical) const noexcept {
+    bool clamped = false;
+    return codec_.to_raw(physical, clamped);
+  }
+  double to_physical(std::uint64_t raw) const noexcept { return codec_.to_physical(raw); }
+  const can::dbc::Signal& signal() const noexcept { return codec_.signal(); }
+
+ private:
+  can::SignalCodec codec_;
 };
 
 /// Decoded BenchCommand.
@@ -59,12 +72,11 @@ struct BenchLayout {
   std::uint32_t command_id = 0x100, sensors_id = 0x200, cro_id = 0x7E0, dto_id = 0x7E1;
   std::uint8_t command_len = 8, sensors_len = 6, cro_len = 8;
   // Defaults: the layout of config/hydraulic_bench.dbc.
-  BitField solenoid_a{0, 16, true, 0.1, 0.0}, solenoid_b{16, 16, true, 0.1, 0.0}, restrictor{32, 16, true, 0.1, 0.0},
-      command_counter{48, 16, true, 1.0, 0.0};
-  BitField pilot{0, 16, true, 100.0 / 65535.0, 0.0}, supply{16, 16, true, 100.0 / 65535.0, 0.0},
-      sensor_counter{32, 16, true, 1.0, 0.0};
-  BitField cro_cmd{0, 8, true, 1.0, 0.0}, cro_ctr{8, 8, true, 1.0, 0.0}, dto_pid{0, 8, true, 1.0, 0.0},
-      dto_err{8, 8, true, 1.0, 0.0};
+  BitField solenoid_a{0, 16, 0.1, 0, 2000}, solenoid_b{16, 16, 0.1, 0, 2000}, restrictor{32, 16, 0.1, 0, 2000},
+      command_counter{48, 16, 1.0};
+  BitField pilot{0, 16, 0.00152590218966964, 0, 100}, supply{16, 16, 0.00152590218966964, 0, 100},
+      sensor_counter{32, 16, 1.0};
+  BitField cro_cmd{0, 8, 1.0}, cro_ctr{8, 8, 1.0}, dto_pid{0, 8, 1.0}, dto_err{8, 8, 1.0};
 
   /// Reads the layout from a DBC file. Throws lash::InputError naming the file and the
   /// missing message/signal (or a counter narrower than 8 bits). Not real-time safe.
