@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "lash/can/log.hpp"
+#include "lash/control/gains_file.hpp"
 #include "lash/io/csv.hpp"
 #include "lash/io/error.hpp"
 #include "lash/io/toml_util.hpp"
@@ -44,7 +45,13 @@ BenchSettings load_bench_settings(const std::filesystem::path& file) {
     }
     p->finish();
   }
-  if (auto c = t.table_opt("controller")) {
+  const toml::node* cnode = t.has("controller") ? root.get("controller") : nullptr;
+  if (cnode != nullptr && cnode->is_string()) {
+    // The control module's gains file (e.g. config/control/thesis_gains.toml).
+    const double dt_keep = s.controller.pid.dt_s;
+    s.controller = load_controller_config(dir / t.string("controller"));
+    s.controller.pid.dt_s = dt_keep;
+  } else if (auto c = t.table_opt("controller")) {
     auto& g = s.controller.pid.gains;
     g.kp = c->number_or("kp", g.kp);
     g.ki_per_s = c->number_or("ki_per_s", g.ki_per_s);
