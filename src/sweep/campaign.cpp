@@ -1,5 +1,7 @@
 #include "lash/sweep/campaign.hpp"
 
+#include "lash/identify/config_file.hpp"
+
 #include <cmath>
 #include <stdexcept>
 
@@ -25,71 +27,10 @@ std::vector<double> nonempty_numbers(TomlTable& t, const char* key, bool positiv
   return v;
 }
 
-/// The `[estimator]` table, laid out like `lash estimate --config` files (docs/identification.md):
-/// model-level keys at the top, `[estimator.rls]` and `[estimator.noise]` below.
+/// The `[estimator]` table: exactly the layout of `lash estimate --config` files
+/// (lash::read_estimator_config, docs/identification.md), then validated as a whole.
 void read_estimator(TomlTable& t, EstimatorConfig& e) {
-  if (auto m = t.string_opt("model")) {
-    try {
-      e.model = parse_model_kind(*m);
-    } catch (const std::invalid_argument& ex) {
-      t.fail("model", ex.what());
-    }
-  }
-  if (auto m = t.string_opt("method")) {
-    try {
-      e.method = parse_method(*m);
-    } catch (const std::invalid_argument& ex) {
-      t.fail("method", ex.what());
-    }
-  }
-  e.guess_left = t.number_or("guess_left", e.guess_left);
-  e.guess_right = t.number_or("guess_right", e.guess_right);
-  auto count = [](TomlTable& tt, const char* key, auto& field) {
-    if (auto v = tt.integer_opt(key)) {
-      if (*v < 0) tt.fail(key, "must be >= 0");
-      field = static_cast<std::remove_reference_t<decltype(field)>>(*v);
-    }
-  };
-  count(t, "iv_delay", e.iv_delay);
-  count(t, "min_updates", e.min_updates);
-  if (auto b = t.boolean_opt("pooled")) e.pooled = *b;
-  if (auto b = t.boolean_opt("sim_side_by_sign")) e.sim_side_by_sign = *b;
-  e.singular_tol = t.number_or("singular_tol", e.singular_tol);
-  e.zero_threshold = t.number_or("zero_threshold", e.zero_threshold);
-  e.accel_limit = t.number_or("accel_limit", e.accel_limit);
-  e.stage2_start_s = t.number_or("stage2_start", e.stage2_start_s);
-  if (auto rt = t.table_opt("rls")) {
-    auto& r = e.rls;
-    r.lambda = rt->number_or("lambda", r.lambda);
-    r.p0 = rt->number_or("p0", r.p0);
-    auto triple = [&](const char* key, std::array<double, 3>& out) {
-      if (auto v = rt->numbers_opt(key)) {
-        if (v->size() != 3) rt->fail(key, "expected 3 numbers [a1, b1, e]");
-        for (std::size_t i = 0; i < 3; ++i) out[i] = (*v)[i];
-      }
-    };
-    triple("eta0", r.eta0);
-    triple("lower", r.lower);
-    triple("upper", r.upper);
-    r.trace_max = rt->number_or("trace_max", r.trace_max);
-    if (auto f = rt->string_opt("forgetting")) {
-      if (*f == "exponential") r.forgetting = Forgetting::exponential;
-      else if (*f == "directional") r.forgetting = Forgetting::directional;
-      else rt->fail("forgetting", "expected \"exponential\" or \"directional\"");
-    }
-    rt->finish();
-  }
-  if (auto nt = t.table_opt("noise")) {
-    auto& n = e.noise;
-    count(*nt, "filter_length", n.filter_length);
-    if (auto b = nt->boolean_opt("filter_input")) n.filter_input = *b;
-    count(*nt, "input_delay", n.input_delay);
-    count(*nt, "derivative_filter_length", n.derivative_filter_length);
-    n.derivative_threshold = nt->number_or("derivative_threshold", n.derivative_threshold);
-    count(*nt, "align_delay", n.align_delay);
-    nt->finish();
-  }
-  t.finish();
+  read_estimator_config(t, e);
   try {
     e.validate();
   } catch (const std::invalid_argument& ex) {
