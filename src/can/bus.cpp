@@ -56,11 +56,7 @@ class MemBus final : public Bus {
       const Frame f = ring_[head_];
       head_ = (head_ + 1) % kCapacity;
       --count_;
-      if (!passes(filters_, f)) {
-        stats_.filtered.fetch_add(1, std::memory_order_relaxed);
-        continue;
-      }
-      stats_.received.fetch_add(1, std::memory_order_relaxed);
+      if (!accept(filters_, f, stats_)) continue;
       return f;
     }
   }

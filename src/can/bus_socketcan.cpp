@@ -115,21 +115,11 @@ class SocketCanBus final : public Bus {
       timespec rt{};
       clock_gettime(CLOCK_REALTIME, &rt);
       f.timestamp_s = static_cast<double>(rt.tv_sec) + static_cast<double>(rt.tv_nsec) * 1e-9;
-      for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c; c = CMSG_NXTHDR(&msg, c)) {
-        if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SO_TIMESTAMPNS) {
-          timespec ts{};
-          std::memcpy(&ts, CMSG_DATA(c), sizeof ts);
-          f.timestamp_s = static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
-        }
-      }
+      kernel_timestamp(msg, f.timestamp_s);
       {
         std::lock_guard lk(filter_mu_);
-        if (!passes(filters_, f)) {
-          stats_.filtered.fetch_add(1, std::memory_order_relaxed);
-          continue;
-        }
+        if (!accept(filters_, f, stats_)) continue;
       }
-      stats_.received.fetch_add(1, std::memory_order_relaxed);
       return f;
     }
   }
