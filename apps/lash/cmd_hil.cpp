@@ -24,7 +24,9 @@
 
 #include "cli_common.hpp"
 #include "lash/can/bus.hpp"
+#include "lash/can/controller_bus.hpp"
 #include "lash/can/log.hpp"
+#include "lash/control/step_metrics.hpp"
 #include "lash/hil/netns.hpp"
 #include "lash/hil/nodes.hpp"
 #include "lash/hil/report.hpp"
@@ -121,6 +123,8 @@ json loop_json(const rt::PeriodicLoop& loop, const rt::RunResult& r, const std::
   j["steps"] = r.steps;
   j["stop_reason"] = rt::to_string(r.reason);
   j["tet_us"] = summary_json(loop.tet_us());
+  j["io_us"] = summary_json(loop.io_us());
+  j["cycle_us"] = summary_json(loop.cycle_us());
   j["wake_latency_us"] = summary_json(loop.wake_latency_us());
   j["overruns"] = r.overruns;
   json ov = json::array();
@@ -207,17 +211,20 @@ int run_slave(const SlaveOptions& o) {
   rt::PeriodicLoop run_loop(lc);
   const double epoch = realtime_now_s() - static_cast<double>(rt::monotonic_ns() - lc.start_ns) * 1e-9;
   (void)epoch;
-  const rt::RunResult r = run_loop.run(
+  // The task sees the emulated CAN controller; its reception and transmission are the I/O phases.
+  can::ControllerBus ctl(*bus);
+  const rt::RunResult r = run_loop.run_with_io(
+      [&]() noexcept { ctl.pull(); },
       [&](std::size_t, std::int64_t t_ns) noexcept {
-        slave.step(*bus, static_cast<double>(t_ns) * 1e-9);
+        slave.step(ctl, static_cast<double>(t_ns) * 1e-9);
         return true;
       },
-      g_stop);
+      [&]() noexcept { ctl.flush(); }, g_stop);
 
   // Logs (after the run; the loop stopped at a step boundary).
   const auto log = slave.log();
   const auto rec = run_loop.records();
-  std::vector<double> c_step, c_t, c_cnt, c_fresh, c_i, c_p, c_y, c_raw, c_tet, c_lat;
+  std::vector<double> c_step, c_t, c_cnt, c_fresh, c_i, c_p, c_y, c_raw, c_tet, c_io, c_lat;
   for (std::size_t i = 0; i < log.size(); ++i) {
     c_step.push_back(log[i].step);
     c_t.push_back(static_cast<double>(rec[i].release_ns) * 1e-9);
@@ -228,27 +235,33 @@ int run_slave(const SlaveOptions& o) {
     c_y.push_back(log[i].measured_kPa);
     c_raw.push_back(log[i].pilot_raw);
     c_tet.push_back(static_cast<double>(rec[i].tet_ns) * 1e-3);
+    c_io.push_back(static_cast<double>(rec[i].io_ns) * 1e-3);
     c_lat.push_back(static_cast<double>(rec[i].wake_latency_ns) * 1e-3);
   }
   write_columns_csv(o.log,
                     {"step", "t_s", "command_counter", "command_fresh", "current_mA", "pressure_kPa", "measured_kPa",
-                     "pilot_raw", "tet_us", "wake_latency_us"},
-                    {&c_step, &c_t, &c_cnt, &c_fresh, &c_i, &c_p, &c_y, &c_raw, &c_tet, &c_lat});
+                     "pilot_raw", "tet_us", "io_us", "wake_latency_us"},
+                    {&c_step, &c_t, &c_cnt, &c_fresh, &c_i, &c_p, &c_y, &c_raw, &c_tet, &c_io, &c_lat});
   json j = loop_json(run_loop, r, warnings);
   const auto& c = slave.commands();
   const auto bs = bus->stats();
   j["frames"] = {{"sent", slave.frames_sent()},     {"received", c.received}, {"late", c.late},
                  {"lost", c.lost},                   {"duplicates", c.duplicates}, {"resyncs", c.resyncs},
                  {"ignored", slave.ignored_frames()}, {"send_failures", slave.send_failures()},
-                 {"bus_filtered", bs.filtered},      {"bus_dropped", bs.dropped}};
+                 {"bus_filtered", bs.filtered},      {"bus_dropped", bs.dropped},
+                 {"rx_overflows", ctl.controller_stats().rx_overflows},
+                 {"tx_overflows", ctl.controller_stats().tx_overflows},
+                 {"tx_failures", ctl.controller_stats().tx_failures}};
   j["dto_replies"] = slave.dto_replies();
   j["seed"] = s.plant.seed;
   if (!o.stats.empty()) write_json(o.stats, j);
   const auto tet = run_loop.tet_us();
   fmt::print(stderr,
-             "lash hil slave: {} steps ({}), TET mean {:.2f} us max {:.2f} us, overruns {}, commands received {} "
+             "lash hil slave: {} steps ({}), TET mean {:.2f} us max {:.2f} us (CAN I/O mean {:.2f} us), overruns {}, "
+             "commands received {} "
              "late {} lost {}\n",
-             r.steps, rt::to_string(r.reason), tet.mean, tet.max, r.overruns, c.received, c.late, c.lost);
+             r.steps, rt::to_string(r.reason), tet.mean, tet.max, run_loop.io_us().mean, r.overruns, c.received, c.late,
+             c.lost);
   return kExitOk;
 }
 
@@ -297,18 +310,20 @@ int run_master(const MasterOptions& o) {
   for (const auto& w : warnings) fmt::print(stderr, "lash hil master: warning: {}\n", w);
   auto bus = open_node_bus(s.bus, L, true);
   const auto N = static_cast<std::int64_t>(control_steps);
-  const rt::RunResult r = loop.run(
+  can::ControllerBus ctl(*bus);
+  const rt::RunResult r = loop.run_with_io(
+      [&]() noexcept { ctl.pull(); },
       [&](std::size_t, std::int64_t t_ns) noexcept {
-        const bool ok = master.step(*bus, static_cast<double>(t_ns) * 1e-9);
+        const bool ok = master.step(ctl, static_cast<double>(t_ns) * 1e-9);
         return ok && master.control_steps() < N;
       },
-      g_stop);
+      [&]() noexcept { ctl.flush(); }, g_stop);
   const double epoch = realtime_now_s() - static_cast<double>(rt::monotonic_ns() - loop.start_ns()) * 1e-9;
 
   // Logs.
   const auto log = master.log();
   const auto rec = loop.records();
-  std::vector<double> c_step, c_t, c_state, c_m, c_r, c_y, c_sc, c_fresh, c_i, c_cc, c_tet, c_lat;
+  std::vector<double> c_step, c_t, c_state, c_m, c_r, c_y, c_sc, c_fresh, c_i, c_cc, c_tet, c_io, c_lat;
   for (std::size_t i = 0; i < log.size() && i < rec.size(); ++i) {
     const auto& l = log[i];
     c_step.push_back(l.step);
@@ -322,12 +337,13 @@ int run_master(const MasterOptions& o) {
     c_i.push_back(l.current_mA);
     c_cc.push_back(l.command_sent ? l.command_counter : -1.0);
     c_tet.push_back(static_cast<double>(rec[i].tet_ns) * 1e-3);
+    c_io.push_back(static_cast<double>(rec[i].io_ns) * 1e-3);
     c_lat.push_back(static_cast<double>(rec[i].wake_latency_ns) * 1e-3);
   }
   write_columns_csv(o.log,
                     {"step", "t_s", "state", "control_step", "reference_kPa", "measured_kPa", "sensor_counter",
-                     "sensor_fresh", "current_mA", "command_counter", "tet_us", "wake_latency_us"},
-                    {&c_step, &c_t, &c_state, &c_m, &c_r, &c_y, &c_sc, &c_fresh, &c_i, &c_cc, &c_tet, &c_lat});
+                     "sensor_fresh", "current_mA", "command_counter", "tet_us", "io_us", "wake_latency_us"},
+                    {&c_step, &c_t, &c_state, &c_m, &c_r, &c_y, &c_sc, &c_fresh, &c_i, &c_cc, &c_tet, &c_io, &c_lat});
   if (!o.bus_log.empty()) {
     std::vector<can::LogEntry> entries;
     entries.reserve(master.bus_log().size());
@@ -351,7 +367,10 @@ int run_master(const MasterOptions& o) {
                  {"lost", sn.lost},                   {"duplicates", sn.duplicates}, {"resyncs", sn.resyncs},
                  {"ignored", master.ignored_frames()}, {"send_failures", master.send_failures()},
                  {"bus_filtered", bs.filtered},       {"bus_dropped", bs.dropped},
-                 {"bus_log_dropped", master.bus_log_dropped()}};
+                 {"bus_log_dropped", master.bus_log_dropped()},
+                 {"rx_overflows", ctl.controller_stats().rx_overflows},
+                 {"tx_overflows", ctl.controller_stats().tx_overflows},
+                 {"tx_failures", ctl.controller_stats().tx_failures}};
   j["state"] = to_string(master.state());
   j["control_steps"] = master.control_steps();
   j["handshake_s"] = master.handshake_s();
@@ -419,7 +438,7 @@ int run_simulate(const SimulateOptions& o) {
   if (auto w = hil::find_step(c_r, s.step_s)) {
     std::vector<double> t(c_t.begin() + static_cast<std::ptrdiff_t>(w->begin), c_t.begin() + static_cast<std::ptrdiff_t>(w->end));
     std::vector<double> p(c_p.begin() + static_cast<std::ptrdiff_t>(w->begin), c_p.begin() + static_cast<std::ptrdiff_t>(w->end));
-    const hil::StepResponse sm = hil::step_response(t, p, w->t_step_s, w->y0, w->y1);
+    const StepMetrics sm = step_metrics(t, p, w->t_step_s, w->y0, w->y1);
     fmt::print("step {} -> {} kPa at t = {} s: 90% rise {:.4f} s, 10% settling {:.4f} s, overshoot {:.1f} %\n",
                format_double(w->y0), format_double(w->y1), format_double(w->t_step_s), sm.rise_s, sm.settling_s,
                sm.overshoot_pct);
@@ -591,13 +610,13 @@ int run_run(const RunOptions& o) {
   json step_json = json::object();
   const auto& p_slave = st["pressure_kPa"];
   const auto& y_slave = st["measured_kPa"];
-  std::optional<hil::StepResponse> sm, sm_meas;
+  std::optional<StepMetrics> sm, sm_meas;
   std::optional<hil::StepWindow> win = hil::find_step(ref, s.step_s);
   if (win && win->end <= p_slave.size()) {
     const auto b = static_cast<std::ptrdiff_t>(win->begin), e = static_cast<std::ptrdiff_t>(win->end);
     std::vector<double> t(t_m.begin() + b, t_m.begin() + e);
-    sm = hil::step_response(t, std::vector<double>(p_slave.begin() + b, p_slave.begin() + e), win->t_step_s, win->y0, win->y1);
-    sm_meas = hil::step_response(t, std::vector<double>(y_slave.begin() + b, y_slave.begin() + e), win->t_step_s, win->y0,
+    sm = step_metrics(t, std::vector<double>(p_slave.begin() + b, p_slave.begin() + e), win->t_step_s, win->y0, win->y1);
+    sm_meas = step_metrics(t, std::vector<double>(y_slave.begin() + b, y_slave.begin() + e), win->t_step_s, win->y0,
                            win->y1);
     step_json = {{"t_step_s", win->t_step_s}, {"from_kPa", win->y0}, {"to_kPa", win->y1},
                  {"rise_s", sm->rise_s},      {"settling_s", sm->settling_s}, {"overshoot_pct", sm->overshoot_pct},
@@ -613,7 +632,8 @@ int run_run(const RunOptions& o) {
   out["isolation"] = isolation;
   out["bus"] = s.bus;
   auto node = [](const json& j) {
-    return json{{"tet_us", j.at("tet_us")},       {"wake_latency_us", j.at("wake_latency_us")},
+    return json{{"tet_us", j.at("tet_us")},       {"io_us", j.at("io_us")},
+                {"cycle_us", j.at("cycle_us")},   {"wake_latency_us", j.at("wake_latency_us")},
                 {"overruns", j.at("overruns")},   {"steps", j.at("steps")},
                 {"frames", j.at("frames")},       {"warnings", j.at("warnings")}};
   };
@@ -653,12 +673,17 @@ int run_run(const RunOptions& o) {
   } else {
     auto line = [](const char* who, const json& j) {
       const auto& t = j.at("tet_us");
+      const auto& io = j.at("io_us");
+      const auto& c = j.at("cycle_us");
       const auto& w = j.at("wake_latency_us");
-      fmt::print("{:<7} TET [us] mean {:8.3f} min {:8.3f} max {:8.3f} std {:7.3f} p99 {:8.3f} | wake-up latency [us] "
-                 "mean {:7.2f} p99 {:8.2f} max {:8.2f} | overruns {}\n",
+      fmt::print("{:<7} TET [us] mean {:7.3f} min {:7.3f} max {:8.3f} std {:7.3f} p99 {:8.3f} | CAN I/O [us] mean {:7.2f} "
+                 "p99 {:8.2f} | cycle [us] mean {:7.2f} max {:8.2f}\n",
                  who, t.at("mean").get<double>(), t.at("min").get<double>(), t.at("max").get<double>(),
-                 t.at("std").get<double>(), t.at("p99").get<double>(), w.at("mean").get<double>(),
-                 w.at("p99").get<double>(), w.at("max").get<double>(), j.at("overruns").get<std::uint64_t>());
+                 t.at("std").get<double>(), t.at("p99").get<double>(), io.at("mean").get<double>(),
+                 io.at("p99").get<double>(), c.at("mean").get<double>(), c.at("max").get<double>());
+      fmt::print("{:<7} wake-up latency [us] mean {:7.2f} p99 {:8.2f} max {:8.2f} | overruns {}\n", "",
+                 w.at("mean").get<double>(), w.at("p99").get<double>(), w.at("max").get<double>(),
+                 j.at("overruns").get<std::uint64_t>());
     };
     fmt::print("lash hil run: {} s at {} ms, reference {}, bus {} in a {}\n", format_double(o.duration),
                format_double(s.step_s * 1e3), o.reference, s.bus, isolation);

@@ -7,6 +7,17 @@
 #include "lash/io/error.hpp"
 
 namespace lash::can {
+
+std::size_t Bus::receive_batch(std::span<Frame> out, std::size_t max_reads) noexcept {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < max_reads && n < out.size(); ++i) {
+    auto f = receive(std::chrono::nanoseconds(0));
+    if (!f) break;
+    out[n++] = *f;
+  }
+  return n;
+}
+
 namespace detail {
 namespace {
 

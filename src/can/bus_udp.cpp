@@ -18,6 +18,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <charconv>
@@ -126,6 +127,10 @@ class UdpBus final : public Bus {
     const int one = 1;
     ::setsockopt(rx_, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
     ::setsockopt(rx_, SOL_SOCKET, SO_TIMESTAMPNS, &one, sizeof one);
+    // Room for about a thousand queued datagrams (a burst, or a flood read at a bounded rate);
+    // the kernel caps it at net.core.rmem_max.
+    const int rcvbuf = 1 << 20;
+    ::setsockopt(rx_, SOL_SOCKET, SO_RCVBUF, &rcvbuf, sizeof rcvbuf);
     sockaddr_in bind_addr{};
     bind_addr.sin_family = AF_INET;
     bind_addr.sin_port = htons(o.port);
@@ -177,12 +182,13 @@ class UdpBus final : public Bus {
   }
 
   std::optional<Frame> receive(std::chrono::nanoseconds timeout) noexcept override {
-    timespec now{};
-    clock_gettime(CLOCK_MONOTONIC, &now);
-    const std::int64_t deadline_ns = now.tv_sec * 1000000000LL + now.tv_nsec + timeout.count();
+    const std::int64_t deadline_ns = monotonic_now_ns() + timeout.count();
+    // A poll (timeout 0) reads at most kPollReads datagrams, so a flood of filtered frames
+    // cannot keep it looping; a wait is bounded by its deadline.
+    std::size_t reads = 0;
     for (;;) {
-      clock_gettime(CLOCK_MONOTONIC, &now);
-      const std::int64_t left_ns = deadline_ns - (now.tv_sec * 1000000000LL + now.tv_nsec);
+      const std::int64_t left_ns = deadline_ns - monotonic_now_ns();
+      if (timeout.count() <= 0 && reads >= kPollReads) return std::nullopt;
       pollfd p{rx_, POLLIN, 0};
       timespec tmo{};
       if (left_ns > 0) {
@@ -195,36 +201,41 @@ class UdpBus final : public Bus {
         continue;
       }
       if (pr <= 0) return std::nullopt;
-      std::array<std::uint8_t, udp::kMaxDatagram + 1> buf;
-      alignas(cmsghdr) char control[CMSG_SPACE(sizeof(timespec))];
-      sockaddr_in src{};
-      iovec iov{buf.data(), buf.size()};
-      msghdr msg{};
-      msg.msg_name = &src;
-      msg.msg_namelen = sizeof src;
-      msg.msg_iov = &iov;
-      msg.msg_iovlen = 1;
-      msg.msg_control = control;
-      msg.msg_controllen = sizeof control;
-      const ssize_t n = ::recvmsg(rx_, &msg, MSG_TRUNC | MSG_DONTWAIT);
+      Slot slot;
+      slot.prepare();
+      const ssize_t n = ::recvmsg(rx_, &slot.msg, MSG_TRUNC | MSG_DONTWAIT);
       if (n < 0) continue;
-      if (src.sin_addr.s_addr == self_.sin_addr.s_addr && src.sin_port == self_.sin_port) continue;  // own frame
+      ++reads;
       Frame f;
-      const auto st = static_cast<std::size_t>(n) > udp::kMaxDatagram || (msg.msg_flags & MSG_TRUNC)
-                          ? udp::DecodeStatus::oversized
-                          : udp::decode_datagram({buf.data(), static_cast<std::size_t>(n)}, f);
-      if (st != udp::DecodeStatus::ok) {
-        stats_.dropped.fetch_add(1, std::memory_order_relaxed);
-        continue;
-      }
-      f.timestamp_s = realtime_now();
-      kernel_timestamp(msg, f.timestamp_s);
-      {
-        std::lock_guard lk(filter_mu_);
-        if (!accept(filters_, f, stats_)) continue;
-      }
-      return f;
+      if (take(slot.msg, static_cast<std::size_t>(n), slot, f)) return f;
     }
+  }
+
+  std::size_t receive_batch(std::span<Frame> out, std::size_t max_reads) noexcept override {
+    // recvmmsg: up to kBatch datagrams per system call, none waited for.
+    std::size_t stored = 0, reads = 0;
+    while (stored < out.size() && reads < max_reads) {
+      const std::size_t want = std::min({kBatch, max_reads - reads, out.size() - stored});
+      std::array<Slot, kBatch> slots;
+      std::array<mmsghdr, kBatch> mm{};
+      for (std::size_t i = 0; i < want; ++i) {
+        slots[i].prepare();
+        mm[i].msg_hdr = slots[i].msg;
+      }
+      const int got = ::recvmmsg(rx_, mm.data(), static_cast<unsigned>(want), MSG_TRUNC | MSG_DONTWAIT, nullptr);
+      if (got < 0) {
+        if (errno == EINTR) continue;
+        break;  // EAGAIN: nothing queued
+      }
+      if (got == 0) break;
+      reads += static_cast<std::size_t>(got);
+      for (int i = 0; i < got; ++i) {
+        const auto k = static_cast<std::size_t>(i);
+        if (take(mm[k].msg_hdr, mm[k].msg_len, slots[k], out[stored])) ++stored;
+      }
+      if (static_cast<std::size_t>(got) < want) break;  // the queue is empty
+    }
+    return stored;
   }
 
   void set_filters(std::vector<Filter> filters) override {
@@ -245,6 +256,52 @@ class UdpBus final : public Bus {
     if (tx_ >= 0) ::close(tx_);
     rx_ = tx_ = -1;
     fail(msg);
+  }
+
+  static constexpr std::size_t kPollReads = 256;  ///< datagrams one receive(0) reads at most
+  static constexpr std::size_t kBatch = 32;       ///< datagrams per recvmmsg call
+
+  /// Buffers of one datagram read (recvmsg or one recvmmsg entry).
+  struct Slot {
+    std::array<std::uint8_t, udp::kMaxDatagram + 1> buf;
+    alignas(cmsghdr) char control[CMSG_SPACE(sizeof(timespec))];
+    sockaddr_in src{};
+    iovec iov{};
+    msghdr msg{};
+    void prepare() noexcept {
+      iov = {buf.data(), buf.size()};
+      msg = msghdr{};
+      msg.msg_name = &src;
+      msg.msg_namelen = sizeof src;
+      msg.msg_iov = &iov;
+      msg.msg_iovlen = 1;
+      msg.msg_control = control;
+      msg.msg_controllen = sizeof control;
+    }
+  };
+
+  static std::int64_t monotonic_now_ns() noexcept {
+    timespec now{};
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    return now.tv_sec * 1000000000LL + now.tv_nsec;
+  }
+
+  /// Decodes one received datagram of n bytes into f; false (and counted) for our own
+  /// frames, malformed or oversized datagrams and frames the filters drop.
+  bool take(msghdr& msg, std::size_t n, const Slot& slot, Frame& f) noexcept {
+    const auto* src = static_cast<const sockaddr_in*>(msg.msg_name);
+    if (src->sin_addr.s_addr == self_.sin_addr.s_addr && src->sin_port == self_.sin_port) return false;  // own frame
+    const auto st = n > udp::kMaxDatagram || (msg.msg_flags & MSG_TRUNC)
+                        ? udp::DecodeStatus::oversized
+                        : udp::decode_datagram({slot.buf.data(), n}, f);
+    if (st != udp::DecodeStatus::ok) {
+      stats_.dropped.fetch_add(1, std::memory_order_relaxed);
+      return false;
+    }
+    f.timestamp_s = realtime_now();
+    kernel_timestamp(msg, f.timestamp_s);
+    std::lock_guard lk(filter_mu_);
+    return accept(filters_, f, stats_);
   }
 
   std::string spec_;

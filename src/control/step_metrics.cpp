@@ -51,9 +51,12 @@ StepMetrics step_metrics(const std::vector<double>& t_s, const std::vector<doubl
   } else if (last_out + 1 >= t_s.size()) {
     m.settling_s = nan;  // still outside at the end of the record
   } else {
+    // Entered the band for good between last_out and last_out + 1: interpolate the crossing of
+    // the band edge on the side it came from (linear in s, also when the sample jumps across 1).
     const std::size_t i = last_out + 1;
-    const double a = std::fabs(s(i - 1) - 1.0), b = std::fabs(s(i) - 1.0);
-    const double f = (a - settle_band) / (a - b);
+    const double a = s(i - 1), b = s(i);
+    const double edge = a > 1.0 ? 1.0 + settle_band : 1.0 - settle_band;
+    const double f = (edge - a) / (b - a);
     m.settling_s = t_s[i - 1] + f * (t_s[i] - t_s[i - 1]) - t_step_s;
   }
   return m;

@@ -27,44 +27,6 @@ std::optional<StepWindow> find_step(const std::vector<double>& r, double dt_s, d
   return std::nullopt;
 }
 
-StepResponse step_response(const std::vector<double>& t, const std::vector<double>& y, double t_step, double y0,
-                           double y1) {
-  StepResponse r;
-  const double span = y1 - y0;
-  const double dir = span >= 0 ? 1.0 : -1.0;
-  // Normalised progress z = (y − y0)/(y1 − y0): rise when z reaches 0.9, band |z − 1| ≤ 0.1.
-  auto z = [&](std::size_t i) { return (y[i] - y0) / span; };
-  r.rise_s = std::nan("");
-  double last_exit = t_step;
-  bool ever_out = false;
-  double peak = 0.0;
-  for (std::size_t i = 0; i < t.size() && i < y.size(); ++i) {
-    if (t[i] < t_step) continue;
-    const double zi = z(i);
-    peak = std::max(peak, zi - 1.0);
-    if (std::isnan(r.rise_s) && zi >= 0.9) {
-      double tc = t[i];
-      if (i > 0 && t[i - 1] >= t_step && z(i - 1) < 0.9) tc = t[i - 1] + (0.9 - z(i - 1)) / (zi - z(i - 1)) * (t[i] - t[i - 1]);
-      r.rise_s = tc - t_step;
-    }
-    const bool out = std::abs(zi - 1.0) > 0.1;
-    if (!out && i > 0 && t[i - 1] >= t_step && std::abs(z(i - 1) - 1.0) > 0.1) {
-      // Entered the band between i−1 and i: interpolate the crossing of the band edge.
-      const double zp = z(i - 1);
-      const double edge = zp > 1.0 ? 1.1 : 0.9;
-      last_exit = t[i - 1] + (edge - zp) / (zi - zp) * (t[i] - t[i - 1]);
-      ever_out = true;
-    } else if (out) {
-      last_exit = t[i];
-      ever_out = true;
-    }
-  }
-  (void)dir;
-  r.settling_s = ever_out ? last_exit - t_step : 0.0;
-  r.overshoot_pct = 100.0 * peak;
-  return r;
-}
-
 SimulationDiff compare_with_simulation(const std::vector<std::int64_t>& control_step,
                                        const std::vector<double>& measured_kPa, const std::vector<double>& current_mA,
                                        const std::vector<MasterStepLog>& simulated) {

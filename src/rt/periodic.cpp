@@ -123,18 +123,25 @@ std::vector<std::string> PeriodicLoop::apply_realtime_settings() {
   return warnings;
 }
 
-Summary PeriodicLoop::tet_us() const {
+template <class Get>
+Summary PeriodicLoop::summarize_us(Get get) const {
   std::vector<double> v;
   v.reserve(n_records_);
-  for (const auto& r : records()) v.push_back(static_cast<double>(r.tet_ns) * 1e-3);
+  for (const auto& r : records()) v.push_back(static_cast<double>(get(r)) * 1e-3);
   return summarize(v);
 }
 
+Summary PeriodicLoop::tet_us() const {
+  return summarize_us([](const StepRecord& r) { return r.tet_ns; });
+}
 Summary PeriodicLoop::wake_latency_us() const {
-  std::vector<double> v;
-  v.reserve(n_records_);
-  for (const auto& r : records()) v.push_back(static_cast<double>(r.wake_latency_ns) * 1e-3);
-  return summarize(v);
+  return summarize_us([](const StepRecord& r) { return r.wake_latency_ns; });
+}
+Summary PeriodicLoop::io_us() const {
+  return summarize_us([](const StepRecord& r) { return r.io_ns; });
+}
+Summary PeriodicLoop::cycle_us() const {
+  return summarize_us([](const StepRecord& r) { return r.io_ns + r.tet_ns; });
 }
 
 }  // namespace lash::rt

@@ -252,20 +252,21 @@ TEST(HilMaster, DtoTimeoutFails) {
   EXPECT_EQ(master.events().back().kind, MasterEventKind::dto_timeout);
 }
 
+#include "lash/control/step_metrics.hpp"
 #include "lash/hil/report.hpp"
 
 TEST(HilReport, StepResponseByHand) {
   // Rise: z crosses 0.9 between t=1 (0.5) and t=2 (1.2): 1 + 0.4/0.7. Overshoot 20 %.
   // Settling: last out of band at t=2 (1.2), back in at t=3 (0.95): edge 1.1 crossed at 2 + 0.1/0.25.
   const std::vector<double> t{0, 1, 2, 3, 4}, y{0, 0.5, 1.2, 0.95, 1.0};
-  const StepResponse r = step_response(t, y, 0.0, 0.0, 1.0);
+  const StepMetrics r = step_metrics(t, y, 0.0, 0.0, 1.0);
   EXPECT_NEAR(r.rise_s, 1.0 + 0.4 / 0.7, 1e-12);
   EXPECT_NEAR(r.overshoot_pct, 20.0, 1e-9);
   EXPECT_NEAR(r.settling_s, 2.4, 1e-12);
   // Downward step 10 -> 0 mirrors it.
   std::vector<double> yd;
   for (double v : y) yd.push_back(10.0 - 10.0 * v);
-  const StepResponse d = step_response(t, yd, 0.0, 10.0, 0.0);
+  const StepMetrics d = step_metrics(t, yd, 0.0, 10.0, 0.0);
   EXPECT_NEAR(d.rise_s, r.rise_s, 1e-12);
   EXPECT_NEAR(d.overshoot_pct, 20.0, 1e-9);
   EXPECT_NEAR(d.settling_s, 2.4, 1e-12);
@@ -279,7 +280,7 @@ TEST(HilReport, FirstOrderStepIsTauLn10) {
     t.push_back(1.0 + k * dt);
     y.push_back(1.0 - std::exp(-k * dt / tau));
   }
-  const StepResponse r = step_response(t, y, 1.0, 0.0, 1.0);
+  const StepMetrics r = step_metrics(t, y, 1.0, 0.0, 1.0);
   EXPECT_NEAR(r.rise_s, tau * std::log(10.0), 1e-6);
   EXPECT_NEAR(r.settling_s, tau * std::log(10.0), 1e-6);
   EXPECT_EQ(r.overshoot_pct, 0.0);

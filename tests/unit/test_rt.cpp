@@ -138,3 +138,32 @@ TEST(RtLoop, RealtimeSettingsWarnInsteadOfFailing) {
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_NE(warnings[0].find("does not exist"), std::string::npos);
 }
+
+TEST(RtLoop, IoPhasesAreTimedApartFromTheTask) {
+  // Input and output phases that each spin for >= 100 us around an empty task: the I/O time
+  // holds both (>= 200 us), the TET does not, and the cycle is their sum.
+  LoopConfig c;
+  c.period_ns = 2'000'000;
+  c.max_steps = 5;
+  PeriodicLoop loop(c);
+  std::atomic<bool> stop{false};
+  auto spin = []() noexcept {
+    const std::int64_t t0 = monotonic_ns();
+    while (monotonic_ns() - t0 < 100'000) {
+    }
+  };
+  std::vector<int> order;
+  order.reserve(15);
+  const RunResult r = loop.run_with_io([&]() noexcept { order.push_back(0); spin(); },
+                                       [&](std::size_t, std::int64_t) noexcept { order.push_back(1); return true; },
+                                       [&]() noexcept { order.push_back(2); spin(); }, stop);
+  ASSERT_EQ(r.steps, 5u);
+  for (std::size_t i = 0; i < order.size(); ++i) EXPECT_EQ(order[i], static_cast<int>(i % 3));
+  for (const auto& rec : loop.records()) {
+    EXPECT_GE(rec.io_ns, 200'000);
+    EXPECT_LT(rec.tet_ns, rec.io_ns);
+  }
+  const Summary io = loop.io_us(), tet = loop.tet_us(), cyc = loop.cycle_us();
+  EXPECT_GE(io.min, 200.0);
+  EXPECT_NEAR(cyc.mean, io.mean + tet.mean, 1e-9);
+}

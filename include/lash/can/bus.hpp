@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,11 @@ class Bus {
   /// Waits up to `timeout` for the next frame that passes the filters.
   /// timeout 0 polls. The returned frame carries a receive timestamp [s].
   virtual std::optional<Frame> receive(std::chrono::nanoseconds timeout) noexcept = 0;
+  /// Polls without waiting: stores up to out.size() frames that pass the filters, reading at
+  /// most `max_reads` frames/datagrams from the medium (filtered, own and malformed ones
+  /// count), and returns how many it stored. The bound is what keeps a flood of unrelated
+  /// frames from stretching a real-time step. The default calls receive(0).
+  virtual std::size_t receive_batch(std::span<Frame> out, std::size_t max_reads) noexcept;
   /// Replaces the receive filters (an empty list accepts everything). Not real-time safe.
   virtual void set_filters(std::vector<Filter> filters) = 0;
   virtual BusStats stats() const noexcept = 0;

@@ -4,7 +4,8 @@
 /// - 90 % rise time: time from the step until the response first reaches
 ///   y0 + 0.9·(y1 − y0) (linear interpolation between samples);
 /// - 10 % settling time: time from the step until the response enters the band
-///   |y − y1| ≤ 0.1·|y1 − y0| for good (interpolated at the last exit);
+///   |y − y1| ≤ 0.1·|y1 − y0| for good (the crossing of the band edge it last came
+///   in through, interpolated linearly; NaN if still outside at the end);
 /// - overshoot: max over the window of (y − y1)/(y1 − y0), in percent, ≥ 0.
 /// y0 and y1 are the reference levels before and after the step (not the
 /// noisy measured levels). Not real-time code (scans a trace).

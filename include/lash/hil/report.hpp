@@ -14,7 +14,7 @@ namespace lash::hil {
 
 /// The first reference step (a jump between two samples) whose previous level was held
 /// for at least min_hold_s; the window ends at the next jump, after max_window_s, or at
-/// the end of the trace.
+/// the end of the trace. Its figures come from lash::step_metrics (control/step_metrics.hpp).
 struct StepWindow {
   std::size_t begin = 0;  ///< first sample at the new level
   std::size_t end = 0;    ///< one past the last sample of the window
@@ -24,19 +24,6 @@ struct StepWindow {
 };
 std::optional<StepWindow> find_step(const std::vector<double>& reference, double dt_s, double min_hold_s = 0.5,
                                     double max_window_s = 2.0);
-
-/// Thesis step-response figures of samples y at times t (t ≥ t_step), step y0 → y1:
-/// 90 % rise = first crossing of y0 + 0.9(y1 − y0) (interpolated), 10 % settling = last exit
-/// from |y − y1| ≤ 0.1|y1 − y0| (interpolated; 0 if never outside), overshoot = max over the
-/// window of (y − y1)/(y1 − y0) in percent (≥ 0). Times are measured from t_step. NaN rise
-/// when never reached.
-struct StepResponse {
-  double rise_s = 0.0;
-  double settling_s = 0.0;
-  double overshoot_pct = 0.0;
-};
-StepResponse step_response(const std::vector<double>& t_s, const std::vector<double>& y, double t_step_s, double y0,
-                           double y1);
 
 struct SimulationDiff {
   std::size_t compared = 0;               ///< control steps compared

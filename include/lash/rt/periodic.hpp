@@ -8,8 +8,11 @@
 /// Each step records
 ///   - the wake-up latency  s_k − r_k   (s_k = time the step starts),
 ///   - the task execution time (TET)  e_k − s_k  (e_k = time the step returns),
+///   - with run_with_io(), the I/O time around the task: an input phase before it and an
+///     output phase after it (an emulated CAN controller's reception and transmission,
+///     can/controller_bus.hpp), timed apart from the TET; the cycle is I/O + TET,
 /// into a buffer preallocated for the whole run (no allocation on the sample path).
-/// An overrun is a step that misses its deadline r_k + T: it starts after it
+/// An overrun is a step whose cycle misses its deadline r_k + T: it starts after it
 /// (released late by more than a period) or is still running at it. Overruns
 /// are counted and timestamped; a late step is run at once (the grid is kept,
 /// releases are not skipped) and, by policy, the loop is either tolerant or
@@ -19,6 +22,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace lash::rt {
@@ -45,7 +49,8 @@ struct LoopConfig {
 struct StepRecord {
   std::int64_t release_ns = 0;       ///< r_k − start [ns]
   std::int64_t wake_latency_ns = 0;  ///< s_k − r_k [ns]
-  std::int64_t tet_ns = 0;           ///< e_k − s_k [ns]
+  std::int64_t tet_ns = 0;           ///< task execution time [ns]
+  std::int64_t io_ns = 0;            ///< input + output phase time around the task [ns] (0 without I/O phases)
 };
 
 /// A step that missed its deadline.
@@ -87,6 +92,14 @@ class PeriodicLoop {
   /// true (checked at every step boundary and while sleeping).
   template <class Step>
   RunResult run(Step&& step, const std::atomic<bool>& stop) noexcept {
+    return run_with_io([]() noexcept {}, std::forward<Step>(step), []() noexcept {}, stop);
+  }
+
+  /// As run(), with an input phase before and an output phase after each step (both
+  /// noexcept callables). The TET times the step alone; the phases are recorded as I/O time;
+  /// the deadline applies to the whole cycle.
+  template <class Input, class Step, class Output>
+  RunResult run_with_io(Input&& input, Step&& step, Output&& output, const std::atomic<bool>& stop) noexcept {
     const std::int64_t T = cfg_.period_ns;
     start_ns_ = cfg_.start_ns != 0 ? cfg_.start_ns : monotonic_ns() + T;
     n_records_ = 0;
@@ -101,9 +114,13 @@ class PeriodicLoop {
         break;
       }
       const std::int64_t s = monotonic_ns();
+      input();
+      const std::int64_t s_task = monotonic_ns();
       const bool keep_going = step(k, s - start_ns_);
+      const std::int64_t e_task = monotonic_ns();
+      output();
       const std::int64_t e = monotonic_ns();
-      records_[n_records_++] = StepRecord{r - start_ns_, s - r, e - s};
+      records_[n_records_++] = StepRecord{r - start_ns_, s - r, e_task - s_task, (s_task - s) + (e - e_task)};
       const std::int64_t deadline = r + T;
       if (e > deadline) {
         overruns_[n_overruns_++] = OverrunEvent{k, s - start_ns_, e - deadline};
@@ -128,11 +145,16 @@ class PeriodicLoop {
   std::int64_t start_ns() const noexcept { return start_ns_; }
   std::span<const StepRecord> records() const noexcept { return {records_.data(), n_records_}; }
   std::span<const OverrunEvent> overruns() const noexcept { return {overruns_.data(), n_overruns_}; }
-  /// TET and wake-up latency statistics over the recorded steps [µs].
+  /// Statistics over the recorded steps [µs]: TET, wake-up latency, I/O time, and the cycle
+  /// (I/O + TET: what the deadline is checked against, wake-up latency excluded).
   Summary tet_us() const;
   Summary wake_latency_us() const;
+  Summary io_us() const;
+  Summary cycle_us() const;
 
  private:
+  template <class Get>
+  Summary summarize_us(Get get) const;
   LoopConfig cfg_;
   std::int64_t start_ns_ = 0;
   std::vector<StepRecord> records_;
