@@ -60,6 +60,7 @@ struct CommonOptions {
   double step_ms = 0.0;  // 0 = from the settings file
   int fifo = 0;
   int cpu = -1;
+  double spin_us = 0.0;
   bool lock_memory = false;
   std::string overrun_policy = "tolerate";
   std::size_t max_overruns = 10;
@@ -71,6 +72,7 @@ void add_common(CLI::App* sub, CommonOptions& o) {
   sub->add_option("--step-ms", o.step_ms, "Fixed step [ms]; default from the settings (5 ms)");
   sub->add_option("--fifo", o.fifo, "SCHED_FIFO priority 1-99 (0 = default scheduler)");
   sub->add_option("--cpu", o.cpu, "Pin the loop to this CPU");
+  sub->add_option("--spin-us", o.spin_us, "Wake this long before each release and busy-wait to it [us] (0 = sleep only)");
   sub->add_flag("--lock-memory", o.lock_memory, "mlockall() the process");
   sub->add_option("--overrun-policy", o.overrun_policy, "tolerate | stop");
   sub->add_option("--max-overruns", o.max_overruns, "Policy stop: stop after this many consecutive overruns");
@@ -95,6 +97,9 @@ rt::LoopConfig loop_config(const CommonOptions& o, double step_s, std::size_t st
   if (o.fifo < 0 || o.fifo > 99) throw InputError("", 0, "--fifo", "must be in 0..99");
   c.fifo_priority = o.fifo;
   c.cpu = o.cpu;
+  if (!(o.spin_us >= 0) || !std::isfinite(o.spin_us)) throw InputError("", 0, "--spin-us", "must be >= 0 [us]");
+  c.spin_ns = static_cast<std::int64_t>(std::llround(o.spin_us * 1e3));
+  if (c.spin_ns >= c.period_ns) throw InputError("", 0, "--spin-us", "must be shorter than the step");
   c.lock_memory = o.lock_memory;
   if (o.overrun_policy == "tolerate")
     c.policy = rt::OverrunPolicy::tolerate;
@@ -183,6 +188,8 @@ int run_slave(const SlaveOptions& o) {
   const auto warnings = loop.apply_realtime_settings();
   for (const auto& w : warnings) fmt::print(stderr, "lash hil slave: warning: {}\n", w);
   auto bus = open_node_bus(s.bus, L, false);
+  // The task sees an emulated CAN controller; its reception and transmission are the I/O phases.
+  can::ControllerBus ctl(*bus);
   fmt::print("lash hil slave: ready on {} (step {} ms)\n", bus->address(), format_double(s.step_s * 1e3));
   std::fflush(stdout);
 
@@ -206,13 +213,12 @@ int run_slave(const SlaveOptions& o) {
   }
   const std::int64_t t_connect = rt::monotonic_ns();
   fmt::print(stderr, "lash hil slave: CCP CONNECT answered with the recorded DTO; stepping\n");
-  // The slave's grid sits half a period after the master's (see nodes.hpp).
-  lc.start_ns = t_connect + lc.period_ns / 2;
-  rt::PeriodicLoop run_loop(lc);
+  // The slave's grid sits half a period after the master's (see nodes.hpp). The loop and its
+  // buffers exist already, so the first step is not delayed by allocation or page faults.
+  loop.set_start_ns(t_connect + lc.period_ns / 2);
+  rt::PeriodicLoop& run_loop = loop;
   const double epoch = realtime_now_s() - static_cast<double>(rt::monotonic_ns() - lc.start_ns) * 1e-9;
   (void)epoch;
-  // The task sees the emulated CAN controller; its reception and transmission are the I/O phases.
-  can::ControllerBus ctl(*bus);
   const rt::RunResult r = run_loop.run_with_io(
       [&]() noexcept { ctl.pull(); },
       [&](std::size_t, std::int64_t t_ns) noexcept {
@@ -456,6 +462,7 @@ struct RunOptions {
   bool json_out = false;
   bool no_isolate = false;
   std::int64_t seed = -1;
+  int slave_cpu = -1;  // -1 = as --cpu
 };
 
 struct Child {
@@ -527,6 +534,7 @@ std::vector<std::string> common_args(const CommonOptions& c, const std::string& 
   std::vector<std::string> a{"--config", config, "--bus", bus, "--step-ms", format_double(step_ms)};
   if (c.fifo > 0) a.insert(a.end(), {"--fifo", std::to_string(c.fifo)});
   if (c.cpu >= 0) a.insert(a.end(), {"--cpu", std::to_string(c.cpu)});
+  if (c.spin_us > 0) a.insert(a.end(), {"--spin-us", format_double(c.spin_us)});
   if (c.lock_memory) a.push_back("--lock-memory");
   a.insert(a.end(), {"--overrun-policy", c.overrun_policy, "--max-overruns", std::to_string(c.max_overruns)});
   return a;
@@ -554,7 +562,9 @@ int run_run(const RunOptions& o) {
   }
   const std::string dir = o.out_dir;
   std::vector<std::string> slave_args{"lash", "hil", "slave"};
-  for (auto& a : common_args(o.common, config, s.bus, s.step_s * 1e3)) slave_args.push_back(a);
+  CommonOptions slave_common = o.common;
+  if (o.slave_cpu >= 0) slave_common.cpu = o.slave_cpu;
+  for (auto& a : common_args(slave_common, config, s.bus, s.step_s * 1e3)) slave_args.push_back(a);
   slave_args.insert(slave_args.end(), {"--duration", format_double(o.duration + s.dto_timeout_s + 5.0), "--log",
                                        dir + "/slave.csv", "--stats", dir + "/slave.json", "--seed",
                                        std::to_string(s.plant.seed)});
@@ -744,6 +754,7 @@ Command add_hil(CLI::App& app) {
   run->add_option("--seed", ro->seed, "Noise seed of the plant");
   run->add_flag("--json", ro->json_out, "Print the report as one JSON object");
   run->add_flag("--no-isolate", ro->no_isolate, "Use the host's network instead of a private namespace");
+  run->add_option("--slave-cpu", ro->slave_cpu, "Pin the slave to this CPU (default: as --cpu, which pins the master)");
 
   auto sio = std::make_shared<SimulateOptions>();
   auto* sim = hil->add_subcommand("simulate", "Closed-loop simulation through the nodes' step functions");

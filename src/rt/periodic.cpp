@@ -72,6 +72,8 @@ PeriodicLoop::PeriodicLoop(LoopConfig cfg) : cfg_(cfg) {
   if (cfg_.fifo_priority < 0 || cfg_.fifo_priority > 99)
     throw std::invalid_argument("rt: SCHED_FIFO priority must be in 0..99");
   if (cfg_.max_consecutive_overruns == 0) throw std::invalid_argument("rt: max_consecutive_overruns must be >= 1");
+  if (cfg_.spin_ns < 0 || cfg_.spin_ns >= cfg_.period_ns)
+    throw std::invalid_argument("rt: spin must be >= 0 and shorter than the period");
   records_.resize(cfg_.max_steps);
   overruns_.resize(cfg_.max_steps);
 }

@@ -44,6 +44,34 @@ TEST(RtLoop, RejectsBadConfig) {
   c.period_ns = 1000;
   c.fifo_priority = 100;
   EXPECT_THROW(PeriodicLoop{c}, std::invalid_argument);
+  c.fifo_priority = 0;
+  c.spin_ns = 1000;  // spin as long as the period: never sleeps
+  EXPECT_THROW(PeriodicLoop{c}, std::invalid_argument);
+  c.spin_ns = -1;
+  EXPECT_THROW(PeriodicLoop{c}, std::invalid_argument);
+}
+
+TEST(RtLoop, SpinKeepsTheGridAndSetStartFixesThePhase) {
+  // With a spin margin the releases are still exactly k·T after the start chosen by
+  // set_start_ns(), and no step starts before its release.
+  LoopConfig c;
+  c.period_ns = 500'000;
+  c.max_steps = 20;
+  c.spin_ns = 100'000;
+  PeriodicLoop loop(c);
+  const std::int64_t start = monotonic_ns() + 2'000'000;
+  loop.set_start_ns(start);
+  std::atomic<bool> stop{false};
+  std::vector<std::int64_t> begun;
+  begun.reserve(20);
+  loop.run([&](std::size_t, std::int64_t) noexcept { begun.push_back(monotonic_ns()); return true; }, stop);
+  EXPECT_EQ(loop.start_ns(), start);
+  ASSERT_EQ(begun.size(), 20u);
+  for (std::size_t k = 0; k < 20; ++k) {
+    EXPECT_EQ(loop.records()[k].release_ns, static_cast<std::int64_t>(k) * 500'000);
+    EXPECT_GE(begun[k], start + static_cast<std::int64_t>(k) * 500'000);
+    EXPECT_GE(loop.records()[k].wake_latency_ns, 0);
+  }
 }
 
 TEST(RtLoop, RunsAllStepsOnAbsoluteGrid) {

@@ -41,6 +41,7 @@ struct LoopConfig {
   int fifo_priority = 0;                   ///< SCHED_FIFO priority 1–99; 0 keeps the default scheduler
   bool lock_memory = false;                ///< mlockall(MCL_CURRENT | MCL_FUTURE) and pre-fault the stack
   int cpu = -1;                            ///< pin to this CPU; −1 = no affinity change
+  std::int64_t spin_ns = 0;                ///< sleep until r_k − spin_ns, then busy-wait to r_k (0 = sleep only)
   OverrunPolicy policy = OverrunPolicy::tolerate;
   std::size_t max_consecutive_overruns = 10;  ///< policy stop: stop after this many in a row (≥ 1)
 };
@@ -108,7 +109,15 @@ class PeriodicLoop {
     std::size_t consecutive = 0;
     for (std::size_t k = 0; k < cfg_.max_steps; ++k) {
       const std::int64_t r = start_ns_ + static_cast<std::int64_t>(k) * T;
-      sleep_until_ns(r, &stop);
+      if (cfg_.spin_ns > 0) {
+        // Wake early and spin to the release: the core stays awake (no idle-state exit, no
+        // hypervisor round trip) at the price of spin_ns of CPU per step.
+        sleep_until_ns(r - cfg_.spin_ns, &stop);
+        while (monotonic_ns() < r && !stop.load(std::memory_order_relaxed)) {
+        }
+      } else {
+        sleep_until_ns(r, &stop);
+      }
       if (stop.load(std::memory_order_relaxed)) {
         res.reason = StopReason::requested;
         break;
@@ -141,6 +150,9 @@ class PeriodicLoop {
     return res;
   }
 
+  /// Sets r_0 for the next run (absolute CLOCK_MONOTONIC [ns]; 0 = now + T), e.g. once a
+  /// handshake has fixed the phase: the loop is built (and its buffers touched) beforehand.
+  void set_start_ns(std::int64_t t_ns) noexcept { cfg_.start_ns = t_ns; }
   const LoopConfig& config() const noexcept { return cfg_; }
   std::int64_t start_ns() const noexcept { return start_ns_; }
   std::span<const StepRecord> records() const noexcept { return {records_.data(), n_records_}; }
