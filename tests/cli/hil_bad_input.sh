@@ -37,6 +37,10 @@ write_cfg "" "$tmp/nodto.log"
 expect2 "nodto.log" hil simulate --config "$tmp/bench.toml" -o "$tmp/b.csv"
 [[ -e "$tmp/b.csv" ]] && fail "output written despite bad input"
 
+expect2 "--spin-us" hil master --bus mem:x --spin-us 5000 --log "$tmp/c.csv"
+expect2 "--spin-us" hil slave --bus mem:x --spin-us -1 --log "$tmp/c.csv"
+[[ -e "$tmp/c.csv" ]] && fail "log written despite bad input"
+
 # No slave on an in-process bus: the master gives up after its DTO timeout.
 "$LASH" hil master --bus mem:lonely --dto-timeout 0.1 --duration 1 --log "$tmp/m.csv" 2>"$tmp/err"; rc=$?
 [[ $rc == 1 ]] || fail "master without slave: expected exit 1, got $rc"

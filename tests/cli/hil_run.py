@@ -20,6 +20,7 @@ REQUIRED = [
     ("master", "tet_us", "mean"), ("master", "tet_us", "min"), ("master", "tet_us", "max"),
     ("master", "tet_us", "std"), ("master", "tet_us", "p99"), ("master", "overruns"),
     ("slave", "tet_us", "mean"), ("slave", "tet_us", "p99"), ("master", "wake_latency_us", "p99"),
+    ("master", "io_us", "mean"), ("master", "cycle_us", "max"), ("slave", "io_us", "mean"),
     ("frames", "sent"), ("frames", "received"), ("frames", "late"), ("frames", "lost"),
     ("step_response", "rise_s"), ("step_response", "settling_s"), ("step_response", "overshoot_pct"),
     ("max_abs_diff_vs_simulation_kPa",),
@@ -29,7 +30,7 @@ clean = None
 for attempt in range(3):
     out = tempfile.mkdtemp(prefix="lash_hil_run_")
     r = subprocess.run([hil_netns.lash(), "hil", "run", "--duration", "5", "--step-ms", "5", "--json", "--fifo", "50",
-                        "--lock-memory", "--out-dir", out], capture_output=True, text=True, timeout=60)
+                        "--lock-memory", "--spin-us", "200", "--out-dir", out], capture_output=True, text=True, timeout=60)
     assert r.returncode == 0, r.stderr
     rep = json.loads(r.stdout)
     for path in REQUIRED:
@@ -53,6 +54,14 @@ for attempt in range(3):
     off += [int(st) for st, cc, fr in zip(s["step"], s["command_counter"], s["command_fresh"])
             if 0 < st < rep["master"]["control_steps"] and (fr == 0 or int(cc) != int(st) - 1)]
     assert rep["off_schedule_steps"] == len(set(off)), (rep["off_schedule_steps"], len(set(off)))
+    # TET (the task) and CAN I/O (the emulated controller) are logged per step; the report's
+    # means are those of the logs, and the cycle is their sum.
+    for node, log in (("master", m), ("slave", s)):
+        n = len(log["tet_us"])
+        tet, io = sum(log["tet_us"]) / n, sum(log["io_us"]) / n
+        assert abs(rep[node]["tet_us"]["mean"] - tet) < 1e-3 and abs(rep[node]["io_us"]["mean"] - io) < 1e-3, node
+        assert abs(rep[node]["cycle_us"]["mean"] - (tet + io)) < 2e-3, node
+        assert rep[node]["tet_us"]["min"] >= 0 and rep[node]["io_us"]["min"] > 0, node
     print(f"attempt {attempt}: late+lost {late}, off-schedule steps {len(set(off))}, overruns "
           f"{rep['master']['overruns']}/{rep['slave']['overruns']}, diff {rep['max_abs_diff_vs_simulation_kPa']} kPa, "
           f"master TET mean {rep['master']['tet_us']['mean']:.2f} us, wake-up p99 "
