@@ -58,14 +58,20 @@ MasterConfig master_cfg() {
   return m;
 }
 
-void BM_HilMasterStep(benchmark::State& state) {
-  BenchLayout L;
+/// A master past its CCP handshake on `bus`.
+MasterNode connected_master(const BenchLayout& L, ScriptedBus& bus) {
   MasterNode master(L, master_cfg());
-  ScriptedBus bus;
   master.step(bus, 0.0);  // CRO
   bus.next = dto();
   bus.pending = true;
   master.step(bus, 0.0);  // connected
+  return master;
+}
+
+void BM_HilMasterStep(benchmark::State& state) {
+  BenchLayout L;
+  ScriptedBus bus;
+  MasterNode master = connected_master(L, bus);
   std::uint16_t c = 0;
   for (auto _ : state) {
     bus.next = L.pack_sensors({static_cast<std::uint16_t>(17000 + (c & 255)), 0, c});
@@ -81,12 +87,8 @@ BENCHMARK(BM_HilMasterStep);
 // steps, untimed): the worst case of a task woken after 5 ms of other work on the core.
 void BM_HilMasterStepColdCache(benchmark::State& state) {
   BenchLayout L;
-  MasterNode master(L, master_cfg());
   ScriptedBus bus;
-  master.step(bus, 0.0);  // CRO
-  bus.next = dto();
-  bus.pending = true;
-  master.step(bus, 0.0);  // connected
+  MasterNode master = connected_master(L, bus);
   std::vector<unsigned char> junk(32u << 20);
   std::uint16_t c = 0;
   for (auto _ : state) {
