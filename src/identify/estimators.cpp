@@ -1,5 +1,6 @@
 #include "lash/identify/estimators.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace lash {
@@ -306,17 +307,26 @@ std::uint64_t CoupledCartsEstimator::skipped() const noexcept {
 void CoupledCartsEstimator::refresh(int i) noexcept {
   const auto& e = rls_[i].eta();
   SideParams& p = p_[i];
-  sa1_[i] = e[0];
-  sb1_[i] = e[1];
-  const double den = 1.0 + e[0];
-  const bool ok = rls_[i].updates() >= cfg_.min_updates && std::fabs(den) > 1e-9;
-  const double c = ok ? -e[2] / den : kNaN;  // eq. 38: e = −c(1 + a1)
-  p.identified = ok && std::isfinite(c);
+  // A side is identified only when its model is usable for the free run and physically sensible:
+  // enough updates, finite, stable (|a1| < 1; a1 ≤ −1 integrates or diverges and made the E5
+  // square-wave free runs overflow), the deadzone edge on its own side of zero (c_r ≥ 0 ≥ c_l,
+  // thesis §1.6.1) and the input not constant over the side's updates (a constant v makes b1
+  // and e inseparable: only b1·v + e is determined — the square wave).
+  const bool stable = std::isfinite(e[0]) && std::isfinite(e[1]) && std::isfinite(e[2]) && std::fabs(e[0]) < 1.0;
+  const double c = stable ? -e[2] / (1.0 + e[0]) : kNaN;  // eq. 38: e = −c(1 + a1)
+  const double span = vhi_[i] - vlo_[i];
+  const bool exciting = span > 1e-9 * std::max(1.0, std::max(std::fabs(vhi_[i]), std::fabs(vlo_[i])));
+  p.identified = rls_[i].updates() >= cfg_.min_updates && stable && std::isfinite(c) &&
+                 (i == 0 ? c >= 0.0 : c <= 0.0) && exciting;
   if (p.identified) {
     p.a1 = e[0];
     p.b1 = e[1];
     p.c = c;
+    // the free run uses the last identified set of each side (never an unstable transient)
+    sa1_[i] = e[0];
+    sb1_[i] = e[1];
     sc_[i] = c;
+    valid_[i] = true;
   } else {
     p = SideParams{};
   }
@@ -350,20 +360,26 @@ double CoupledCartsEstimator::step(double v, double y) noexcept {
   if (dir != 0 && dir == dir1_ && dir == dir2_ && steady) {
     const int i = dir > 0 ? 0 : 1;
     vel_pred = rls_[i].update({-vel1, v1, 1.0}, vel);
+    vlo_[i] = std::min(vlo_[i], v1);
+    vhi_[i] = std::max(vhi_[i], v1);
     refresh(i);
   } else if (dir1_ != 0) {
     vel_pred = rls_[dir1_ > 0 ? 0 : 1].predict({-vel1, v1, 1.0});
   }
   yhat_ = y1_ + cfg_.dt_s * vel_pred;
-  // free-run: velocity model (output deadzone) → integrate (eq. 39–40) → deadband (eq. 41)
+  // free-run: velocity model (output deadzone) → integrate (eq. 39–40) → deadband (eq. 41).
+  // Only identified parameter sets drive it: a side never identified yet predicts no motion
+  // (its linear state follows the other side's model if that one is identified).
   const int ss = x_ > sc_[0] ? 0 : (x_ < sc_[1] ? 1 : sim_last_);
   sim_last_ = ss;
-  x_ = -sa1_[ss] * x_ + sb1_[ss] * vraw1_;
-  wdot_ = detail::deadzone(x_, sc_[1], sc_[0]);
+  const int ms = valid_[ss] ? ss : 1 - ss;
+  x_ = valid_[ms] ? -sa1_[ms] * x_ + sb1_[ms] * vraw1_ : 0.0;
+  wdot_ = valid_[ss] ? detail::deadzone(x_, sc_[1], sc_[0]) : 0.0;
   w_ += cfg_.dt_s * wdot_;
   vraw1_ = v;
-  // stage 2: y − ŵ = o − d moving +, o + d moving − (lash deadband: y = w ∓ d while engaged)
-  if (k_ >= stage2_k_ && dir != 0) {
+  // stage 2: y − ŵ = o − d moving +, o + d moving − (lash deadband: y = w ∓ d while engaged);
+  // ŵ means something only once both sides of the velocity model have been identified.
+  if (k_ >= stage2_k_ && valid_[0] && valid_[1] && dir != 0) {
     drls_.update({1.0, dir > 0 ? -1.0 : 1.0}, s.y - w_);
     ++dcount_[dir > 0 ? 0 : 1];
   }

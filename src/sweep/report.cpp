@@ -29,6 +29,11 @@ std::string label(const RunSpec& s) {
 
 std::string pct(double share) { return fmt::format("{:.1f} %", 100.0 * share); }
 
+/// An NRMSE for the summary: never "inf %" or "nan %" without saying why.
+std::string nrmse_text(double x) {
+  return std::isfinite(x) ? pct(x) : std::string("not computed (no output in the window or a non-finite error)");
+}
+
 nlohmann::json num(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
 
 }  // namespace
@@ -55,6 +60,9 @@ Summary summarize(const Campaign& c, const std::vector<RunResult>& results) {
       if (r.side[sd].identified) ++s.sides_identified;
     }
     if (r.side.right.identified && r.side.left.identified && r.side.left.c > r.side.right.c) ++s.unphysical_reported;
+    const bool needs_d = c.rig.kind == rigs::RigKind::coupled_carts;
+    if (r.side.right.identified && r.side.left.identified && (!needs_d || r.d_identified)) ++s.runs_identified;
+    if (!std::isfinite(r.nrmse)) ++s.nrmse_failed;
     if (std::isfinite(r.param_error)) {
       ++s.params_checked;
       if (r.param_error <= c.param_tolerance) ++s.params_within;
@@ -88,11 +96,16 @@ std::string summary_text(const Campaign& c, const Summary& s, const std::vector<
                      format_double(c.window_end_s), pct(s.threshold), s.good, s.runs, pct(s.share_good));
   for (const auto& w : s.per_waveform)
     out += fmt::format("  {:<11} {:>4}/{:<4} = {:>7}   median NRMSE {}\n", w.waveform, w.good, w.runs, pct(w.share_good),
-                       pct(w.median_nrmse));
+                       nrmse_text(w.median_nrmse));
   if (!results.empty()) {
-    out += fmt::format("median run: {} NRMSE {}\n", label(results[s.median_index].spec), pct(s.median_nrmse));
-    out += fmt::format("worst run:  {} NRMSE {}\n", label(results[s.worst_index].spec), pct(s.worst_nrmse));
+    out += fmt::format("median run: {} NRMSE {}\n", label(results[s.median_index].spec), nrmse_text(s.median_nrmse));
+    out += fmt::format("worst run:  {} NRMSE {}\n", label(results[s.worst_index].spec), nrmse_text(s.worst_nrmse));
   }
+  if (s.nrmse_failed > 0)
+    out += fmt::format("runs whose NRMSE could not be computed: {} (counted as not good, ranked worst)\n", s.nrmse_failed);
+  out += fmt::format("runs with the whole model identified{}: {}/{}\n",
+                     c.rig.kind == rigs::RigKind::coupled_carts ? " (both sides and d)" : " (both sides)",
+                     s.runs_identified, s.runs);
   out += fmt::format("sides identified: {}/{}; identified with c_l > c_r: {}\n", s.sides_identified, s.sides_total,
                      s.unphysical_reported);
   out += fmt::format("parameters within {} of the rig's true effective values: {}/{} runs with identified sides\n",
@@ -122,6 +135,8 @@ std::string summary_json(const Campaign& c, const Summary& s, const std::vector<
   j["sides_identified"] = s.sides_identified;
   j["sides_total"] = s.sides_total;
   j["identified_with_cl_gt_cr"] = s.unphysical_reported;
+  j["runs_identified"] = s.runs_identified;
+  j["nrmse_failed"] = s.nrmse_failed;
   j["param_tolerance"] = s.param_tolerance;
   j["params_checked"] = s.params_checked;
   j["params_within_tolerance"] = s.params_within;

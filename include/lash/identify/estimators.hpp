@@ -265,7 +265,10 @@ class CoupledCartsEstimator {
   Rls<2> drls_;
   std::array<std::uint64_t, 2> dcount_{};
   std::array<SideParams, 2> p_{};
-  std::array<double, 2> sa1_{}, sb1_{}, sc_{};
+  std::array<double, 2> sa1_{}, sb1_{}, sc_{};  // last identified set per side (free run)
+  std::array<bool, 2> valid_{};                   // side identified at least once
+  std::array<double, 2> vlo_{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+  std::array<double, 2> vhi_{-std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
   double vel1_ = 0.0, v1_ = 0.0, vraw1_ = 0.0, y1_ = 0.0;
   int dir1_ = 0, dir2_ = 0, sim_last_ = 0;
   double x_ = 0.0, wdot_ = 0.0, w_ = 0.0, ydb_ = 0.0;

@@ -80,6 +80,10 @@ struct Summary {
   double param_tolerance = 0.05;
   std::size_t sides_identified = 0, sides_total = 0;
   std::size_t unphysical_reported = 0;  ///< identified sides with c_l > c_r (must be 0)
+  /// Runs whose whole model was identified at the end (both sides; coupled carts: and d).
+  std::size_t runs_identified = 0;
+  /// Runs whose NRMSE could not be computed (no output in the window, or a non-finite error).
+  std::size_t nrmse_failed = 0;
 };
 
 Summary summarize(const Campaign& c, const std::vector<RunResult>& results);
