@@ -288,31 +288,25 @@ double DeadzoneDeadbandEstimator::predict_free(int side, double y1, double v1) c
 // ---------------------------------------------------------------- coupled carts (§1.6.3)
 
 CoupledCartsEstimator::CoupledCartsEstimator(const EstimatorConfig& cfg)
-    : cfg_(checked(cfg)),
-      pre_(cfg.noise, cfg.dt_s),
-      rls_{Rls<3>(cfg.rls3()), Rls<3>(cfg.rls3())},
-      drls_([&] {
-        RlsConfig<2> c;
-        c.lambda = 1.0;
-        c.p0 = cfg.rls.p0;
-        return c;
-      }()) {
+    : cfg_(checked(cfg)), pre_(cfg.noise, cfg.dt_s), rls_{Rls<3>(cfg.rls3()), Rls<3>(cfg.rls3())} {
   stage2_k_ = static_cast<std::uint64_t>(std::ceil(cfg.stage2_start_s / cfg.dt_s - 1e-9));
 }
 
 std::uint64_t CoupledCartsEstimator::skipped() const noexcept {
-  return skipped_ + rls_[0].skipped() + rls_[1].skipped() + drls_.skipped();
+  return skipped_ + rls_[0].skipped() + rls_[1].skipped();
 }
 
 void CoupledCartsEstimator::refresh(int i) noexcept {
   const auto& e = rls_[i].eta();
   SideParams& p = p_[i];
   // A side is identified only when its model is usable for the free run and physically sensible:
-  // enough updates, finite, stable (|a1| < 1; a1 ≤ −1 integrates or diverges and made the E5
-  // square-wave free runs overflow), the deadzone edge on its own side of zero (c_r ≥ 0 ≥ c_l,
-  // thesis §1.6.1) and the input not constant over the side's updates (a constant v makes b1
-  // and e inseparable: only b1·v + e is determined — the square wave).
-  const bool stable = std::isfinite(e[0]) && std::isfinite(e[1]) && std::isfinite(e[2]) && std::fabs(e[0]) < 1.0;
+  // enough updates, finite, a stable first-order lag with a positive time constant (−1 < a1 < 0,
+  // τ = −T/ln(−a1); a1 ≤ −1 integrates or diverges and made the E5 square-wave free runs
+  // overflow), the deadzone edge on its own side of zero (c_r ≥ 0 ≥ c_l, thesis §1.6.1) and the
+  // input not constant over the side's updates (a constant v makes b1 and e inseparable: only
+  // b1·v + e is determined — the square wave).
+  const bool stable =
+      std::isfinite(e[0]) && std::isfinite(e[1]) && std::isfinite(e[2]) && e[0] > -1.0 && e[0] < 0.0;
   const double c = stable ? -e[2] / (1.0 + e[0]) : kNaN;  // eq. 38: e = −c(1 + a1)
   const double span = vhi_[i] - vlo_[i];
   const bool exciting = span > 1e-9 * std::max(1.0, std::max(std::fabs(vhi_[i]), std::fabs(vlo_[i])));
@@ -339,7 +333,7 @@ SideParams CoupledCartsEstimator::params(Side s) const noexcept {
 }
 
 double CoupledCartsEstimator::deadband() const noexcept {
-  return dcount_[0] + dcount_[1] >= cfg_.min_updates && dcount_[0] > 0 && dcount_[1] > 0 ? drls_.eta(1) : kNaN;
+  return dcount_[0] + dcount_[1] > 0 ? dsum_ / static_cast<double>(dcount_[0] + dcount_[1]) : kNaN;
 }
 
 bool CoupledCartsEstimator::identified() const noexcept {
@@ -377,14 +371,27 @@ double CoupledCartsEstimator::step(double v, double y) noexcept {
   wdot_ = valid_[ss] ? detail::deadzone(x_, sc_[1], sc_[0]) : 0.0;
   w_ += cfg_.dt_s * wdot_;
   vraw1_ = v;
-  // stage 2: y − ŵ = o − d moving +, o + d moving − (lash deadband: y = w ∓ d while engaged);
-  // ŵ means something only once both sides of the velocity model have been identified.
+  // stage 2 (from stage2_start, once both sides are identified so that ŵ means something):
+  // engaged, y − ŵ = o − d moving +, o + d moving − (y = w ∓ d). ŵ is an open-loop integral of
+  // the velocity model, so o drifts; d is therefore taken per crossing of the slot, where the
+  // drift cancels: when the free cart starts moving the other way, the change of y − ŵ since its
+  // last moving sample is ±2d. d is the mean over crossings; o the least-squares offset given d.
   if (k_ >= stage2_k_ && valid_[0] && valid_[1] && dir != 0) {
-    drls_.update({1.0, dir > 0 ? -1.0 : 1.0}, s.y - w_);
-    ++dcount_[dir > 0 ? 0 : 1];
+    const double r = s.y - w_;
+    if (r_ok_ && dir != dir_last_) {
+      dsum_ += 0.5 * (r - r_last_) * static_cast<double>(dir_last_);
+      ++dcount_[dir > 0 ? 0 : 1];
+    }
+    osum_ += r;
+    odir_ += static_cast<double>(dir);
+    ++on_;
+    r_last_ = r;
+    r_ok_ = true;
   }
-  const double dd = std::isfinite(deadband()) && drls_.eta(1) > 0 ? drls_.eta(1) : 0.0;
-  const double wp = w_ + drls_.eta(0);
+  if (dir != 0) dir_last_ = dir;
+  const double dd = std::isfinite(deadband()) && deadband() > 0.0 ? deadband() : 0.0;
+  const double o = on_ > 0 ? (osum_ + dd * odir_) / static_cast<double>(on_) : 0.0;
+  const double wp = w_ + o;
   if (wp < ydb_ - dd) ydb_ = wp + dd;
   else if (wp > ydb_ + dd) ydb_ = wp - dd;
   ysim_ = ydb_;

@@ -237,9 +237,14 @@ class DeadzoneDeadbandEstimator {
 /// while the pin is engaged and 0 inside the position deadband.
 /// Stage 1: output-deadzone velocity model (eq. 38) updated on samples where the free cart
 /// has moved in one direction for three samples (so ẏ(k), ẏ(k−1) are both ẇ) and
-/// |ÿ| ≤ accel_limit. Stage 2 (t ≥ stage2_start_s): the free-run velocity model is integrated
-/// to ŵ, and y − ŵ = o ∓ d (engaged moving ±) is solved by a 2-parameter RLS for the unknown
-/// integration offset o and the half-width d.
+/// |ÿ| ≤ accel_limit. A side is identified when it has min_updates updates, −1 < a1 < 0, c on
+/// its own side of zero (c_r ≥ 0 ≥ c_l) and the input took more than one value on its updates.
+/// Stage 2 (t ≥ stage2_start_s, both sides identified): the free-run velocity model is
+/// integrated to ŵ; engaged, y − ŵ = o ∓ d (moving ±). o drifts (ŵ is an open-loop integral),
+/// so d is taken per slot crossing: when the free cart starts moving the other way, y − ŵ has
+/// changed by ±2d since its last moving sample. d = mean over crossings (available after the
+/// first); o = least-squares offset given d. The free run uses only identified parameter sets
+/// (the last one per side); a side never identified predicts no motion.
 class CoupledCartsEstimator {
  public:
   explicit CoupledCartsEstimator(const EstimatorConfig& cfg);
@@ -250,7 +255,7 @@ class CoupledCartsEstimator {
   SideParams params(Side s) const noexcept;
   double deadband() const noexcept;
   std::uint64_t updates(Side s) const noexcept { return rls_[detail::side_index(s)].updates(); }
-  /// Stage-2 updates while moving + (plus = true) or −.
+  /// Stage-2 slot crossings that ended moving + (plus = true) or −.
   std::uint64_t deadband_updates(bool plus) const noexcept { return dcount_[plus ? 0 : 1]; }
   std::uint64_t skipped() const noexcept;
   bool identified() const noexcept;
@@ -262,8 +267,11 @@ class CoupledCartsEstimator {
   EstimatorConfig cfg_;
   Preprocessor pre_;
   std::array<Rls<3>, 2> rls_;
-  Rls<2> drls_;
-  std::array<std::uint64_t, 2> dcount_{};
+  std::array<std::uint64_t, 2> dcount_{};  // stage-2 crossings ending in motion + / −
+  double dsum_ = 0.0, r_last_ = 0.0, osum_ = 0.0, odir_ = 0.0;
+  std::uint64_t on_ = 0;
+  int dir_last_ = 0;
+  bool r_ok_ = false;
   std::array<SideParams, 2> p_{};
   std::array<double, 2> sa1_{}, sb1_{}, sc_{};  // last identified set per side (free run)
   std::array<bool, 2> valid_{};                   // side identified at least once
