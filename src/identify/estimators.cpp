@@ -13,6 +13,19 @@ const EstimatorConfig& checked(const EstimatorConfig& c) {
   return c;
 }
 bool finite_all(double a, double b) noexcept { return std::isfinite(a) && std::isfinite(b); }
+
+/// Whether side i's estimate (a1, b1, e) with deadzone edge c may drive the free-run simulation:
+/// finite and stable (|a1| < 1: a1 ≤ −1 integrates or diverges, and such a transient made E3/E4
+/// free runs overflow). The free run holds the last such set of each side.
+bool simulable(const std::array<double, 3>& e, double c) noexcept {
+  return std::isfinite(e[0]) && std::isfinite(e[1]) && std::isfinite(e[2]) && std::fabs(e[0]) < 1.0 &&
+         std::isfinite(c);
+}
+/// Whether side i's deadzone edge is on its own side of zero (c_r ≥ 0 ≥ c_l: a deadzone from
+/// friction or spool overlap contains zero, thesis §1.6.1). A simulable set that fails this still
+/// reproduces the output it was fitted on (e.g. a square wave: only b1·v + e is determined) but is
+/// not presented as identified — the thesis's "negative deadzones hidden by underestimated gains".
+bool physical_edge(double c, int i) noexcept { return i == 0 ? c >= 0.0 : c <= 0.0; }
 }  // namespace
 
 // ---------------------------------------------------------------- linear (eq. 9–16)
@@ -64,17 +77,20 @@ std::uint64_t InputDeadzoneEstimator::skipped() const noexcept {
 void InputDeadzoneEstimator::refresh(int i) noexcept {
   const auto& e = rls_[i].eta();
   SideParams& p = p_[i];
-  sa1_[i] = e[0];
-  sb1_[i] = e[1];
   const bool ok = rls_[i].updates() >= cfg_.min_updates && std::fabs(e[1]) > 1e-12;
   const double c = ok ? -e[2] / e[1] : kNaN;  // e = −b1·c (eq. 21–22)
   // plausibility (eq. 18): the guesses lie outside the deadzone, c_l* < c < c_r*
-  p.identified = ok && std::isfinite(c) && c > cfg_.guess_left && c < cfg_.guess_right;
+  const bool sim = ok && simulable(e, c);
+  if (sim) {  // the free run holds the last stable set of each side (none yet: the guess, b1 = 0)
+    sa1_[i] = e[0];
+    sb1_[i] = e[1];
+    sc_[i] = c;
+  }
+  p.identified = sim && physical_edge(c, i) && c > cfg_.guess_left && c < cfg_.guess_right;
   if (p.identified) {
     p.a1 = e[0];
     p.b1 = e[1];
     p.c = c;
-    sc_[i] = c;
   } else {
     p = SideParams{};
   }
@@ -125,17 +141,20 @@ std::uint64_t OutputDeadzoneEstimator::skipped() const noexcept {
 void OutputDeadzoneEstimator::refresh(int i) noexcept {
   const auto& e = rls_[i].eta();
   SideParams& p = p_[i];
-  sa1_[i] = e[0];
-  sb1_[i] = e[1];
   const double den = 1.0 + e[0];
   const bool ok = rls_[i].updates() >= cfg_.min_updates && std::fabs(den) > 1e-9;
   const double c = ok ? -e[2] / den : kNaN;  // e = −c(1 + a1) (eq. 36)
-  p.identified = ok && std::isfinite(c);
+  const bool sim = ok && simulable(e, c);
+  if (sim) {  // the free run holds the last stable set of each side (none yet: no output)
+    sa1_[i] = e[0];
+    sb1_[i] = e[1];
+    sc_[i] = c;
+  }
+  p.identified = sim && physical_edge(c, i);
   if (p.identified) {
     p.a1 = e[0];
     p.b1 = e[1];
     p.c = c;
-    sc_[i] = c;
   } else {
     p = SideParams{};
   }

@@ -317,6 +317,42 @@ TEST(Estimators, OutputDeadzoneRecoversItsModel) {
   EXPECT_NEAR(e.simulated(), r.y.back(), 1e-6);
 }
 
+TEST(Estimators, UnstableOrUnphysicalSidesNeverDriveTheFreeRun) {
+  // Data of y(k) = 1.002·y(k−1) + 0.001·v(k−1) (a pole outside the unit circle) for v > 0, and
+  // nothing for v ≤ 0: the right side's RLS finds a1 = −1.002 exactly, which is neither
+  // identified nor used by the free run; the left side never updates. So the free-run output is
+  // exactly 0 on every sample while the one-step prediction follows the data.
+  for (ModelKind m : {ModelKind::output_deadzone, ModelKind::input_deadzone}) {
+    EstimatorConfig c = base(m, 0.01);
+    c.guess_left = -0.5;
+    c.guess_right = 0.5;
+    AnyEstimator e(c);
+    double y = 0.0, v1 = 0.0;
+    for (int k = 0; k < 400; ++k) {
+      const double v = 2.0 + std::sin(0.05 * k);  // 1..3 > guess: the right side updates
+      y = 1.002 * y + 0.001 * v1;
+      v1 = v;
+      e.step(v, y);
+      ASSERT_EQ(e.simulated(), 0.0) << "model " << static_cast<int>(m) << " k " << k;
+    }
+    EXPECT_FALSE(e.params(Side::right).identified);
+    EXPECT_FALSE(e.params(Side::left).identified);
+  }
+  // A stable fit with the right edge below zero (data y = 0.9·y(k−1) + 0.1·v(k−1) + 0.05, i.e.
+  // c_r = −0.5 on an output deadzone) is simulated but not presented as identified.
+  EstimatorConfig c = base(ModelKind::output_deadzone, 0.01);
+  AnyEstimator e(c);
+  double y = 0.0, v1 = 0.0;
+  for (int k = 0; k < 400; ++k) {
+    const double v = 2.0 + std::sin(0.05 * k);
+    y = 0.9 * y + 0.1 * v1 + 0.05;
+    v1 = v;
+    e.step(v, y);
+  }
+  EXPECT_FALSE(e.params(Side::right).identified);
+  EXPECT_NE(e.simulated(), 0.0);
+}
+
 Record dzdb_other_plant() {
   // DZ(−100, 50) → G_r = 0.2/(z − 0.9), G_l = 0.3/(z − 0.85) → DB(d_r = 5, d_l = 8); T = 0.01; triangle 400 at 2 rad/s
   std::vector<Block> b;
