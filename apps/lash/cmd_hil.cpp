@@ -404,6 +404,40 @@ int run_master(const MasterOptions& o) {
   return kExitOk;
 }
 
+// ----------------------------------------------------------------------------- latency
+
+struct LatencyOptions {
+  CommonOptions common;
+  double duration = 10.0;
+  bool json_out = false;
+};
+
+/// The periodic loop alone, no bus and no task (like cyclictest): what this machine's scheduler
+/// gives a node with the same real-time options, before any emulation runs on it.
+int run_latency(const LatencyOptions& o) {
+  install_stop_handlers();
+  const hil::BenchSettings s = load_settings(o.common);
+  const std::size_t steps = steps_for(o.duration, s.step_s, "--duration");
+  rt::PeriodicLoop loop(loop_config(o.common, s.step_s, steps));
+  const auto warnings = loop.apply_realtime_settings();
+  for (const auto& w : warnings) fmt::print(stderr, "lash hil latency: warning: {}\n", w);
+  const rt::RunResult r = loop.run([](std::size_t, std::int64_t) noexcept { return true; }, g_stop);
+  const json j = loop_json(loop, r, warnings);
+  if (o.json_out) {
+    fmt::print("{}\n", j.dump(2));
+  } else {
+    const auto w = loop.wake_latency_us();
+    fmt::print("lash hil latency: {} steps of {} ms ({}): wake-up latency [us] mean {:.2f} min {:.2f} p99 {:.2f} "
+               "max {:.2f} std {:.2f}; overruns {}\n",
+               r.steps, format_double(s.step_s * 1e3), rt::to_string(r.reason), w.mean, w.min, w.p99, w.max, w.std,
+               r.overruns);
+    for (const auto& e : loop.overruns())
+      fmt::print("  overrun at step {} (t = {:.3f} s): {:.1f} us late\n", e.step, static_cast<double>(e.t_ns) * 1e-9,
+                 static_cast<double>(e.late_ns) * 1e-3);
+  }
+  return kExitOk;
+}
+
 // ----------------------------------------------------------------------------- simulate
 
 struct SimulateOptions {
@@ -745,6 +779,12 @@ Command add_hil(CLI::App& app) {
   master->add_option("--stats", mo->stats, "Statistics JSON");
   master->add_option("--dto-timeout", mo->dto_timeout, "Give up without a DTO reply after this long [s]");
 
+  auto lo = std::make_shared<LatencyOptions>();
+  auto* lat = hil->add_subcommand("latency", "The periodic loop alone (no bus, no task): wake-up latency and overruns");
+  add_common(lat, lo->common);
+  lat->add_option("--duration", lo->duration, "Measurement time [s]");
+  lat->add_flag("--json", lo->json_out, "Print the statistics as one JSON object");
+
   auto ro = std::make_shared<RunOptions>();
   auto* run = hil->add_subcommand("run", "Slave and master as two processes on a private UDP bus; report");
   add_common(run, ro->common);
@@ -769,6 +809,7 @@ Command add_hil(CLI::App& app) {
             if (slave->parsed()) return run_slave(*so);
             if (master->parsed()) return run_master(*mo);
             if (run->parsed()) return run_run(*ro);
+            if (lat->parsed()) return run_latency(*lo);
             return run_simulate(*sio);
           }};
 }

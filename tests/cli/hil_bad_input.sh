@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Bad input to lash hil: exit 2 with a message naming file, line and field; nothing written.
 # A master without a slave: exit 1 with a clear error after the DTO timeout.
+# `lash hil latency`: the loop alone runs its 200 steps and reports them.
 set -u
 fail() { echo "FAIL: $*"; exit 1; }
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
@@ -40,6 +41,13 @@ expect2 "nodto.log" hil simulate --config "$tmp/bench.toml" -o "$tmp/b.csv"
 expect2 "--spin-us" hil master --bus mem:x --spin-us 5000 --log "$tmp/c.csv"
 expect2 "--spin-us" hil slave --bus mem:x --spin-us -1 --log "$tmp/c.csv"
 [[ -e "$tmp/c.csv" ]] && fail "log written despite bad input"
+
+expect2 "--duration" hil latency --duration 0
+expect2 "--step-ms" hil latency --step-ms -1
+"$LASH" hil latency --duration 0.2 --step-ms 1 --json >"$tmp/lat.json" || fail "hil latency failed"
+grep -q '"steps": 200' "$tmp/lat.json" || fail "hil latency: expected 200 steps: $(head -c 300 "$tmp/lat.json")"
+grep -q '"wake_latency_us"' "$tmp/lat.json" || fail "hil latency: no wake_latency_us"
+echo "ok: hil latency ran 200 steps"
 
 # No slave on an in-process bus: the master gives up after its DTO timeout.
 "$LASH" hil master --bus mem:lonely --dto-timeout 0.1 --duration 1 --log "$tmp/m.csv" 2>"$tmp/err"; rc=$?
