@@ -179,7 +179,7 @@ RunResult run_one(const Campaign& c, const RunSpec& r) {
       } else {
         OutputDeadzoneEstimator est(ec);
         drive(est, rig, same, SimOut{}, sig, n, score, ex);
-        out = finish(c, r, est, score, ex, false);
+        out = finish(c, r, est, score, ex, true);
       }
       out.truth = rig.effective();
       score_params(out, true);
@@ -191,7 +191,7 @@ RunResult run_one(const Campaign& c, const RunSpec& r) {
       if (ec.model == ModelKind::output_deadzone) {
         OutputDeadzoneEstimator est(ec);
         drive(est, rig, same, SimOut{}, sig, n, score, ex);
-        out = finish(c, r, est, score, ex, false);
+        out = finish(c, r, est, score, ex, true);
       } else {
         InputDeadzoneEstimator est(ec);
         drive(est, rig, same, SimOut{}, sig, n, score, ex);
