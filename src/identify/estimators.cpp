@@ -63,30 +63,23 @@ SideParams LinearEstimator::params() const noexcept {
   return p;
 }
 
-// ---------------------------------------------------------------- input deadzone (§1.4.2)
+// ---------------------------------------------------------------- two-side deadzone estimators
 
-InputDeadzoneEstimator::InputDeadzoneEstimator(const EstimatorConfig& cfg)
-    : cfg_(checked(cfg)), pre_(cfg.noise, cfg.dt_s), rls_{Rls<3>(cfg.rls3()), Rls<3>(cfg.rls3())} {
-  sc_ = {cfg.guess_right, cfg.guess_left};
-}
+namespace detail {
 
-std::uint64_t InputDeadzoneEstimator::skipped() const noexcept {
-  return skipped_ + rls_[0].skipped() + rls_[1].skipped();
-}
+TwoSideEstimator::TwoSideEstimator(const EstimatorConfig& cfg)
+    : cfg_(checked(cfg)), pre_(cfg.noise, cfg.dt_s), rls_{Rls<3>(cfg.rls3()), Rls<3>(cfg.rls3())} {}
 
-void InputDeadzoneEstimator::refresh(int i) noexcept {
+void TwoSideEstimator::refresh(int i, double c, bool plausible) noexcept {
   const auto& e = rls_[i].eta();
   SideParams& p = p_[i];
-  const bool ok = rls_[i].updates() >= cfg_.min_updates && std::fabs(e[1]) > 1e-12;
-  const double c = ok ? -e[2] / e[1] : kNaN;  // e = −b1·c (eq. 21–22)
-  // plausibility (eq. 18): the guesses lie outside the deadzone, c_l* < c < c_r*
-  const bool sim = ok && simulable(e, c);
-  if (sim) {  // the free run holds the last stable set of each side (none yet: the guess, b1 = 0)
+  const bool sim = rls_[i].updates() >= cfg_.min_updates && simulable(e, c);
+  if (sim) {  // the free run holds the last stable set of each side (none yet: no output)
     sa1_[i] = e[0];
     sb1_[i] = e[1];
     sc_[i] = c;
   }
-  p.identified = sim && physical_edge(c, i) && c > cfg_.guess_left && c < cfg_.guess_right;
+  p.identified = sim && physical_edge(c, i) && plausible;
   if (p.identified) {
     p.a1 = e[0];
     p.b1 = e[1];
@@ -96,24 +89,40 @@ void InputDeadzoneEstimator::refresh(int i) noexcept {
   }
 }
 
+double TwoSideEstimator::update(int i, double y) noexcept {
+  const std::array<double, 3> phi{-y1_, v1_, 1.0};
+  if (cfg_.method == EstimationMethod::iv) return rls_[i].update_iv(phi, {-hist_.ago(1 + cfg_.iv_delay), v1_, 1.0}, y);
+  return rls_[i].update(phi, y);
+}
+
+}  // namespace detail
+
+// ---------------------------------------------------------------- input deadzone (§1.4.2)
+
+InputDeadzoneEstimator::InputDeadzoneEstimator(const EstimatorConfig& cfg) : TwoSideEstimator(cfg) {
+  sc_ = {cfg.guess_right, cfg.guess_left};
+}
+
+void InputDeadzoneEstimator::refresh(int i) noexcept {
+  const auto& e = rls_[i].eta();
+  const double c = std::fabs(e[1]) > 1e-12 ? -e[2] / e[1] : kNaN;  // e = −b1·c (eq. 21–22)
+  // plausibility (eq. 18): the guesses lie outside the deadzone, c_l* < c < c_r*
+  TwoSideEstimator::refresh(i, c, c > cfg_.guess_left && c < cfg_.guess_right);
+}
+
 double InputDeadzoneEstimator::step(double v, double y) noexcept {
   if (!finite_all(v, y)) {
     ++skipped_;
     return yhat_ = kNaN;
   }
   const Conditioned s = pre_.step(v, y);
-  const double y1 = y1_, v1 = v1_;
-  const int side = v1 > cfg_.guess_right ? 0 : (v1 < cfg_.guess_left ? 1 : -1);
+  const int side = v1_ > cfg_.guess_right ? 0 : (v1_ < cfg_.guess_left ? 1 : -1);
   if (side >= 0) {
-    const std::array<double, 3> phi{-y1, v1, 1.0};
-    if (cfg_.method == EstimationMethod::iv)
-      yhat_ = rls_[side].update_iv(phi, {-hist_.ago(1 + cfg_.iv_delay), v1, 1.0}, s.y);
-    else
-      yhat_ = rls_[side].update(phi, s.y);
+    yhat_ = update(side, s.y);
     refresh(side);
     last_ = side;
   } else {
-    yhat_ = -rls_[last_].eta(0) * y1;  // inside the deadzone u = 0 (eq. 17), a1 of the side last used
+    yhat_ = -rls_[last_].eta(0) * y1_;  // inside the deadzone u = 0 (eq. 17), a1 of the side last used
   }
   hist_.push(s.y);
   y1_ = s.y;
@@ -131,33 +140,13 @@ double InputDeadzoneEstimator::step(double v, double y) noexcept {
 
 // ---------------------------------------------------------------- output deadzone (§1.6.1)
 
-OutputDeadzoneEstimator::OutputDeadzoneEstimator(const EstimatorConfig& cfg)
-    : cfg_(checked(cfg)), pre_(cfg.noise, cfg.dt_s), rls_{Rls<3>(cfg.rls3()), Rls<3>(cfg.rls3())} {}
-
-std::uint64_t OutputDeadzoneEstimator::skipped() const noexcept {
-  return skipped_ + rls_[0].skipped() + rls_[1].skipped();
-}
+OutputDeadzoneEstimator::OutputDeadzoneEstimator(const EstimatorConfig& cfg) : TwoSideEstimator(cfg) {}
 
 void OutputDeadzoneEstimator::refresh(int i) noexcept {
   const auto& e = rls_[i].eta();
-  SideParams& p = p_[i];
   const double den = 1.0 + e[0];
-  const bool ok = rls_[i].updates() >= cfg_.min_updates && std::fabs(den) > 1e-9;
-  const double c = ok ? -e[2] / den : kNaN;  // e = −c(1 + a1) (eq. 36)
-  const bool sim = ok && simulable(e, c);
-  if (sim) {  // the free run holds the last stable set of each side (none yet: no output)
-    sa1_[i] = e[0];
-    sb1_[i] = e[1];
-    sc_[i] = c;
-  }
-  p.identified = sim && physical_edge(c, i);
-  if (p.identified) {
-    p.a1 = e[0];
-    p.b1 = e[1];
-    p.c = c;
-  } else {
-    p = SideParams{};
-  }
+  const double c = std::fabs(den) > 1e-9 ? -e[2] / den : kNaN;  // e = −c(1 + a1) (eq. 36)
+  TwoSideEstimator::refresh(i, c, true);
 }
 
 double OutputDeadzoneEstimator::step(double v, double y) noexcept {
@@ -177,11 +166,7 @@ double OutputDeadzoneEstimator::step(double v, double y) noexcept {
     vraw1_ = v;
   }
   if (side >= 0) {
-    const std::array<double, 3> phi{-y1, v1, 1.0};
-    if (cfg_.method == EstimationMethod::iv)
-      yhat_ = rls_[side].update_iv(phi, {-hist_.ago(1 + cfg_.iv_delay), v1, 1.0}, s.y);
-    else
-      yhat_ = rls_[side].update(phi, s.y);
+    yhat_ = update(side, s.y);
     refresh(side);
   } else {
     const int ps = y1 > z ? 0 : (y1 < -z ? 1 : -1);

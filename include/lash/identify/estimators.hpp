@@ -71,60 +71,65 @@ class LinearEstimator {
   std::uint64_t skipped_ = 0;
 };
 
-/// Input deadzone (§1.4.2, eq. 17–22): side r when v(k−1) > c_r*, l when v(k−1) < c_l*;
-/// e = −b1·c so c = −e/b1. Inside the guesses nothing is updated.
-class InputDeadzoneEstimator {
+namespace detail {
+/// What the two deadzone estimators share: one Rls<3> per side (η = [a1, b1, e]), the side
+/// parameters, the parameter set the free run uses per side, the preprocessor and the
+/// accessors. The models differ in their switching rule and in how c follows from e.
+class TwoSideEstimator {
  public:
-  explicit InputDeadzoneEstimator(const EstimatorConfig& cfg);
-  double step(double v, double y) noexcept;
   double prediction() const noexcept { return yhat_; }
   double simulated() const noexcept { return ysim_; }
-  SideParams params(Side s) const noexcept { return p_[detail::side_index(s)]; }
-  std::uint64_t updates(Side s) const noexcept { return rls_[detail::side_index(s)].updates(); }
-  std::uint64_t skipped() const noexcept;
+  SideParams params(Side s) const noexcept { return p_[side_index(s)]; }
+  std::uint64_t updates(Side s) const noexcept { return rls_[side_index(s)].updates(); }
+  std::uint64_t skipped() const noexcept { return skipped_ + rls_[0].skipped() + rls_[1].skipped(); }
   bool identified() const noexcept { return p_[0].identified && p_[1].identified; }
-  const Rls<3>& rls(Side s) const noexcept { return rls_[detail::side_index(s)]; }
+  const Rls<3>& rls(Side s) const noexcept { return rls_[side_index(s)]; }
 
- private:
-  void refresh(int i) noexcept;
+ protected:
+  explicit TwoSideEstimator(const EstimatorConfig& cfg);
+  /// Side i after an update, with its deadzone edge c (NaN when the model cannot give one) and
+  /// the model's own plausibility test of c. The free run holds the side's last stable set
+  /// (finite, |a1| < 1); the side is identified only if also c_r ≥ 0 ≥ c_l and plausible.
+  void refresh(int i, double c, bool plausible) noexcept;
+  /// Updates side i's RLS with φ = [−y(k−1), v(k−1), 1] (or its instrument); returns ŷ.
+  double update(int i, double y) noexcept;
+
   EstimatorConfig cfg_;
   Preprocessor pre_;
   std::array<Rls<3>, 2> rls_;
   std::array<SideParams, 2> p_{};
   std::array<double, 2> sa1_{}, sb1_{}, sc_{};  // parameters used by the free-run simulation
-  detail::History hist_;
-  double y1_ = 0.0, v1_ = 0.0, vraw1_ = 0.0, w_ = 0.0;
-  int last_ = 0, sim_last_ = 0;
+  History hist_;
+  double y1_ = 0.0, v1_ = 0.0, vraw1_ = 0.0;
+  int sim_last_ = 0;
   double yhat_ = 0.0, ysim_ = 0.0;
   std::uint64_t skipped_ = 0;
+};
+}  // namespace detail
+
+/// Input deadzone (§1.4.2, eq. 17–22): side r when v(k−1) > c_r*, l when v(k−1) < c_l*;
+/// e = −b1·c so c = −e/b1. Inside the guesses nothing is updated.
+class InputDeadzoneEstimator : public detail::TwoSideEstimator {
+ public:
+  explicit InputDeadzoneEstimator(const EstimatorConfig& cfg);
+  double step(double v, double y) noexcept;
+
+ private:
+  void refresh(int i) noexcept;
+  double w_ = 0.0;
+  int last_ = 0;
 };
 
 /// Output deadzone (§1.6.1, eq. 36, motor cart): side r when y(k) > 0 and y(k−1) > 0,
 /// side l when both < 0 (|y| ≤ zero_threshold counts as 0); e = −c(1 + a1).
-class OutputDeadzoneEstimator {
+class OutputDeadzoneEstimator : public detail::TwoSideEstimator {
  public:
   explicit OutputDeadzoneEstimator(const EstimatorConfig& cfg);
   double step(double v, double y) noexcept;
-  double prediction() const noexcept { return yhat_; }
-  double simulated() const noexcept { return ysim_; }
-  SideParams params(Side s) const noexcept { return p_[detail::side_index(s)]; }
-  std::uint64_t updates(Side s) const noexcept { return rls_[detail::side_index(s)].updates(); }
-  std::uint64_t skipped() const noexcept;
-  bool identified() const noexcept { return p_[0].identified && p_[1].identified; }
-  const Rls<3>& rls(Side s) const noexcept { return rls_[detail::side_index(s)]; }
 
  private:
   void refresh(int i) noexcept;
-  EstimatorConfig cfg_;
-  Preprocessor pre_;
-  std::array<Rls<3>, 2> rls_;
-  std::array<SideParams, 2> p_{};
-  std::array<double, 2> sa1_{}, sb1_{}, sc_{};
-  detail::History hist_;
-  double y1_ = 0.0, v1_ = 0.0, vraw1_ = 0.0, x_ = 0.0;
-  int sim_last_ = 0;
-  double yhat_ = 0.0, ysim_ = 0.0;
-  std::uint64_t skipped_ = 0;
+  double x_ = 0.0;
 };
 
 /// Input deadzone + output deadband (§1.4.3, eq. 23–32): four RLS keyed l+, l−, r+, r−.
