@@ -160,7 +160,19 @@ Campaign load_campaign(const std::filesystem::path& path) {
   }
 
   c.estimator = thesis_estimator(kind, c.dt_s);
-  if (auto e = root.table_opt("estimator")) read_estimator(*e, c.estimator);
+  if (auto e = root.table_opt("estimator")) {
+    read_estimator(*e, c.estimator);
+    // The models each rig's runner drives: one output, a deadzone on either side of the linear
+    // part (cart, valve), or the two-stage coupled-carts model.
+    const ModelKind m = c.estimator.model;
+    const bool ok = kind == rigs::RigKind::coupled_carts
+                        ? m == ModelKind::coupled_carts
+                        : (m == ModelKind::input_deadzone || m == ModelKind::output_deadzone);
+    if (!ok)
+      e->fail("model", std::string("model '") + to_string(m) + "' does not run on rig '" + rig_name + "' (" +
+                           (kind == rigs::RigKind::coupled_carts ? "coupled-carts" : "input-deadzone or output-deadzone") +
+                           ")");
+  }
   c.estimator.dt_s = c.dt_s;
   if (auto rp = root.table_opt("rig_params")) {
     c.rig = rigs::read_rig_config(kind, &*rp);

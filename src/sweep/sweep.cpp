@@ -157,6 +157,22 @@ RunResult finish(const Campaign& c, const RunSpec& r, const Est& est, const Scor
   return out;
 }
 
+/// A single-output rig with the input- or output-deadzone estimator, as the campaign says
+/// (load_campaign admits no other model for these rigs).
+template <class Rig>
+RunResult run_deadzone_model(const Campaign& c, const RunSpec& r, Rig& rig, Signal& sig, std::size_t n, Score& score,
+                             Excitation& ex) {
+  auto same = [](double y) { return std::pair<double, double>{y, y}; };
+  if (c.estimator.model == ModelKind::output_deadzone) {
+    OutputDeadzoneEstimator est(c.estimator);
+    drive(est, rig, same, SimOut{}, sig, n, score, ex);
+    return finish(c, r, est, score, ex, true);
+  }
+  InputDeadzoneEstimator est(c.estimator);
+  drive(est, rig, same, SimOut{}, sig, n, score, ex);
+  return finish(c, r, est, score, ex, true);
+}
+
 }  // namespace
 
 RunResult run_one(const Campaign& c, const RunSpec& r) {
@@ -171,32 +187,14 @@ RunResult run_one(const Campaign& c, const RunSpec& r) {
   switch (c.rig.kind) {
     case rigs::RigKind::motor_cart: {
       rigs::MotorCart rig(c.rig.motor_cart, c.dt_s, r.seed);
-      auto same = [](double y) { return std::pair<double, double>{y, y}; };
-      if (ec.model == ModelKind::input_deadzone) {
-        InputDeadzoneEstimator est(ec);
-        drive(est, rig, same, SimOut{}, sig, n, score, ex);
-        out = finish(c, r, est, score, ex, true);
-      } else {
-        OutputDeadzoneEstimator est(ec);
-        drive(est, rig, same, SimOut{}, sig, n, score, ex);
-        out = finish(c, r, est, score, ex, true);
-      }
+      out = run_deadzone_model(c, r, rig, sig, n, score, ex);
       out.truth = rig.effective();
       score_params(out, true);
       break;
     }
     case rigs::RigKind::pilot_valve: {
       rigs::PilotValveRig rig(c.rig.pilot_valve, c.dt_s, r.seed);
-      auto same = [](double y) { return std::pair<double, double>{y, y}; };
-      if (ec.model == ModelKind::output_deadzone) {
-        OutputDeadzoneEstimator est(ec);
-        drive(est, rig, same, SimOut{}, sig, n, score, ex);
-        out = finish(c, r, est, score, ex, true);
-      } else {
-        InputDeadzoneEstimator est(ec);
-        drive(est, rig, same, SimOut{}, sig, n, score, ex);
-        out = finish(c, r, est, score, ex, true);
-      }
+      out = run_deadzone_model(c, r, rig, sig, n, score, ex);
       out.truth = c.rig.pilot_valve.effective(c.dt_s, 0.0);
       score_params(out, false);
       break;

@@ -30,6 +30,7 @@ check bad_waveform     "bad_waveform.toml:6: 'matrix.waveforms'.*sawtooth"      
 check bad_lambda       "bad_lambda.toml:[0-9]+: 'estimator'.*lambda"              "${head}${matrix}"$'[estimator]\nmodel = "output-deadzone"\n[estimator.rls]\nlambda = 1.5\n'
 check bad_rig_value    "bad_rig_value.toml:[0-9]+: 'rig_params'.*mass_kg"         "${head}${matrix}"$'[rig_params]\nmass_kg = -1.0\n'
 check bad_model        "bad_model.toml:[0-9]+: 'estimator.model'"                 "${head}${matrix}"$'[estimator]\nmodel = "quadratic"\n'
+check model_for_rig    "model_for_rig.toml:[0-9]+: 'estimator.model'.*linear.*motor_cart" "${head}${matrix}"$'[estimator]\nmodel = "linear"\n'
 out=$("$LASH" sweep "$d/nope.toml" -q -o "$d/x.csv" 2>&1); rc=$?
 [[ $rc -eq 2 && $out == *"nope.toml: no such file"* && ! -e $d/x.csv ]] || { echo "FAIL missing file: $rc $out"; fail=1; }
 exit $fail
