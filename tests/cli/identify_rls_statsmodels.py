@@ -2,8 +2,9 @@
 """RLS with lambda = 1 and a large P0 agrees with statsmodels RecursiveLS on the same
 regression to 1e-6 relative, at the end and along the way (every 500 samples).
 
-Data: a first-order plant y(k) = 0.9 y(k-1) + 0.5 v(k-1) + 150 + noise (c = -e/b1 = -300, between the guesses -1e9 and -250 as eq. 18 requires) with a seeded random
-input. `lash estimate --model input-deadzone` with guess_right below every input, so every
+Data: a first-order plant y(k) = 0.9 y(k-1) + 0.5 v(k-1) - 150 + noise (c = -e/b1 = 300: on its
+own side of zero, and between the guesses -1e9 and 350 as eq. 18 requires) with a seeded random
+input, uniform over 400..2000 so that the constant column is not nearly collinear with v. `lash estimate --model input-deadzone` with guess_right below every input, so every
 sample updates the right key: the regression is phi = [-y(k-1), v(k-1), 1] -> [a1, b1, e],
 the thesis's 3-parameter RLS (eq. 13-16); lash reports c = -e/b1, converted back here."""
 import csv, json, os, subprocess, sys, tempfile
@@ -20,10 +21,10 @@ LASH = os.environ["LASH"]
 rng = np.random.default_rng(12345)
 n = 5000
 dt = 0.01
-v = 100.0 + 50.0 * rng.standard_normal(n)      # always above the guess -> every sample updates 'right'
+v = rng.uniform(400.0, 2000.0, n)              # always above the guess 350 -> every sample updates 'right'
 y = np.zeros(n)
 for k in range(1, n):
-    y[k] = 0.9 * y[k - 1] + 0.5 * v[k - 1] + 150.0
+    y[k] = 0.9 * y[k - 1] + 0.5 * v[k - 1] - 150.0
 y_meas = y + 2.0 * rng.standard_normal(n)      # measurement noise: LS is not exact, so the comparison is real
 
 fail = 0
@@ -35,7 +36,7 @@ with tempfile.TemporaryDirectory() as d:
             f.write(f"{k * dt!r},{v[k]!r},{y_meas[k]!r}\n")
     trace = os.path.join(d, "trace.csv")
     out = subprocess.run([LASH, "estimate", "--model", "input-deadzone", "--guess-left", "-1e9", "--guess-right",
-                          "-250", "--lambda", "1", "--p0", "1e6", "--min-updates", "1", data, "--json", "-o", trace],
+                          "350", "--lambda", "1", "--p0", "1e6", "--min-updates", "1", data, "--json", "-o", trace],
                          check=True, capture_output=True, text=True).stdout
     j = json.loads(out)
     with open(trace) as f:
@@ -44,10 +45,12 @@ with tempfile.TemporaryDirectory() as d:
 # the same regression for statsmodels: row k is phi(k) = [-y(k-1), v(k-1), 1] with y(-1) = v(-1) = 0
 y1 = np.concatenate([[0.0], y_meas[:-1]])
 v1 = np.concatenate([[0.0], v[:-1]])
-endog = y_meas
-exog = np.column_stack([-y1, v1, np.ones(n)])
+# Row 0 (phi(0) = [0, 0, 1]) is not an update in lash: v(-1) = 0 lies inside the guesses, so the
+# first regression row is k = 1. coef[:, k] below is the estimate after rows 1..k.
+endog = y_meas[1:]
+exog = np.column_stack([-y1, v1, np.ones(n)])[1:]
 res = sm.RecursiveLS(endog, exog).fit()
-coef = res.recursive_coefficients.filtered   # shape (3, n): estimate after each row
+coef = np.concatenate([np.full((3, 1), np.nan), res.recursive_coefficients.filtered], axis=1)  # (3, n)
 
 # lash's a1, b1, c = -e/b1 per step -> back to e
 worst = 0.0
