@@ -8,14 +8,20 @@
 
 namespace lash::can {
 
-std::size_t Bus::receive_batch(std::span<Frame> out, std::size_t max_reads) noexcept {
-  std::size_t n = 0;
-  for (std::size_t i = 0; i < max_reads && n < out.size(); ++i) {
+BatchResult Bus::receive_batch(std::span<Frame> out, std::size_t max_reads) noexcept {
+  // receive(0) applies the filters itself and reports only what passes: each call is one read
+  // of a delivered frame; nothing returned means the queue had nothing (more) for us.
+  BatchResult r;
+  while (r.reads < max_reads && r.stored < out.size()) {
     auto f = receive(std::chrono::nanoseconds(0));
-    if (!f) break;
-    out[n++] = *f;
+    if (!f) {
+      r.drained = true;
+      break;
+    }
+    ++r.reads;
+    out[r.stored++] = *f;
   }
-  return n;
+  return r;
 }
 
 namespace detail {

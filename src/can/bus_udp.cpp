@@ -211,11 +211,11 @@ class UdpBus final : public Bus {
     }
   }
 
-  std::size_t receive_batch(std::span<Frame> out, std::size_t max_reads) noexcept override {
+  BatchResult receive_batch(std::span<Frame> out, std::size_t max_reads) noexcept override {
     // recvmmsg: up to kBatch datagrams per system call, none waited for.
-    std::size_t stored = 0, reads = 0;
-    while (stored < out.size() && reads < max_reads) {
-      const std::size_t want = std::min({kBatch, max_reads - reads, out.size() - stored});
+    BatchResult r;
+    while (r.stored < out.size() && r.reads < max_reads) {
+      const std::size_t want = std::min({kBatch, max_reads - r.reads, out.size() - r.stored});
       std::array<Slot, kBatch> slots;
       std::array<mmsghdr, kBatch> mm{};
       for (std::size_t i = 0; i < want; ++i) {
@@ -225,17 +225,20 @@ class UdpBus final : public Bus {
       const int got = ::recvmmsg(rx_, mm.data(), static_cast<unsigned>(want), MSG_TRUNC | MSG_DONTWAIT, nullptr);
       if (got < 0) {
         if (errno == EINTR) continue;
-        break;  // EAGAIN: nothing queued
+        r.drained = true;  // EAGAIN: nothing queued
+        break;
       }
-      if (got == 0) break;
-      reads += static_cast<std::size_t>(got);
+      r.reads += static_cast<std::size_t>(got);
       for (int i = 0; i < got; ++i) {
         const auto k = static_cast<std::size_t>(i);
-        if (take(mm[k].msg_hdr, mm[k].msg_len, slots[k], out[stored])) ++stored;
+        if (take(mm[k].msg_hdr, mm[k].msg_len, slots[k], out[r.stored])) ++r.stored;
       }
-      if (static_cast<std::size_t>(got) < want) break;  // the queue is empty
+      if (static_cast<std::size_t>(got) < want) {  // the queue is empty
+        r.drained = true;
+        break;
+      }
     }
-    return stored;
+    return r;
   }
 
   void set_filters(std::vector<Filter> filters) override {

@@ -241,11 +241,17 @@ TEST(CanUdp, ReceiveBatchReadsAtMostItsBudget) {
   send_raw(unhex(kPy1), 43202);
   std::this_thread::sleep_for(100ms);
   std::vector<Frame> out(8);
-  EXPECT_EQ(b->receive_batch(out, 100), 0u);
+  BatchResult r = b->receive_batch(out, 100);
+  EXPECT_EQ(r.stored, 0u);
+  EXPECT_EQ(r.reads, 100u);
+  EXPECT_FALSE(r.drained);
   EXPECT_EQ(b->stats().filtered, 100u);
   EXPECT_FALSE(b->receive(0ns).has_value());
   EXPECT_EQ(b->stats().filtered, 356u);
-  EXPECT_EQ(b->receive_batch(out, 100), 1u);  // 44 filtered, then the frame
+  r = b->receive_batch(out, 100);  // 44 filtered, then the frame, then nothing
+  EXPECT_EQ(r.stored, 1u);
+  EXPECT_EQ(r.reads, 45u);
+  EXPECT_TRUE(r.drained);
   EXPECT_EQ(out[0].id, 0x123u);
   EXPECT_EQ(b->stats().filtered, 400u);
   EXPECT_EQ(b->stats().received, 1u);
@@ -277,9 +283,9 @@ TEST(CanController, FifosDecoupleTheTaskFromTheWire) {
     ASSERT_TRUE(peer->send(f));
   }
   EXPECT_FALSE(ctl.receive(0ns).has_value());
-  EXPECT_EQ(ctl.pull(), 4u);  // one FIFO's worth per pull
-  EXPECT_EQ(ctl.pull(), 2u);
+  EXPECT_EQ(ctl.pull(), 6u);  // drained in two batches of at most one FIFO's worth
   EXPECT_EQ(ctl.controller_stats().rx_overflows, 2u);
+  EXPECT_EQ(ctl.controller_stats().pulls_cut, 0u);
   for (std::uint32_t i = 2; i < 6; ++i) EXPECT_EQ(ctl.receive(0ns)->id, 0x20 + i);
   EXPECT_FALSE(ctl.receive(0ns).has_value());
   // Filters are the wire's (the controller's acceptance filters).
@@ -291,5 +297,26 @@ TEST(CanController, FifosDecoupleTheTaskFromTheWire) {
   EXPECT_EQ(ctl.pull(), 1u);
   EXPECT_EQ(ctl.receive(0ns)->id, 0x30u);
   EXPECT_EQ(ctl.stats().filtered, 1u);
-  EXPECT_THROW(ControllerBus(*wire_a, ControllerConfig{0, 1, 1}), std::invalid_argument);
+  EXPECT_THROW(ControllerBus(*wire_a, ControllerConfig{0, 1, 1, 0}), std::invalid_argument);
+  EXPECT_THROW(ControllerBus(*wire_a, ControllerConfig{1, 1, 1, -1}), std::invalid_argument);
+}
+
+TEST(CanController, PullStopsAtItsReadBudget) {
+  // 10 frames queued, at most 3 wire reads per pull(): 3 + 3 + 3 + 1, each cut pull counted.
+  auto wire = open_bus("mem:ctl2");
+  auto peer = open_bus("mem:ctl2");
+  ControllerBus ctl(*wire, ControllerConfig{16, 2, 3, 0});
+  Frame f;
+  f.len = 1;
+  for (std::uint32_t i = 0; i < 10; ++i) {
+    f.id = 0x40 + i;
+    ASSERT_TRUE(peer->send(f));
+  }
+  EXPECT_EQ(ctl.pull(), 3u);
+  EXPECT_EQ(ctl.pull(), 3u);
+  EXPECT_EQ(ctl.pull(), 3u);
+  EXPECT_EQ(ctl.pull(), 1u);
+  EXPECT_EQ(ctl.controller_stats().pulls_cut, 3u);
+  EXPECT_EQ(ctl.controller_stats().rx_reads, 10u);
+  for (std::uint32_t i = 0; i < 10; ++i) EXPECT_EQ(ctl.receive(0ns)->id, 0x40 + i);
 }

@@ -29,6 +29,13 @@ struct BusStats {
   std::uint64_t dropped = 0;    ///< malformed/oversized/unknown datagrams or queue overflow
 };
 
+/// What one Bus::receive_batch() call did.
+struct BatchResult {
+  std::size_t stored = 0;  ///< frames written to `out` (they passed the filters)
+  std::size_t reads = 0;   ///< frames/datagrams taken from the medium
+  bool drained = false;    ///< the medium had nothing more queued when the call returned
+};
+
 class Bus {
  public:
   virtual ~Bus() = default;
@@ -39,9 +46,9 @@ class Bus {
   virtual std::optional<Frame> receive(std::chrono::nanoseconds timeout) noexcept = 0;
   /// Polls without waiting: stores up to out.size() frames that pass the filters, reading at
   /// most `max_reads` frames/datagrams from the medium (filtered, own and malformed ones
-  /// count), and returns how many it stored. The bound is what keeps a flood of unrelated
-  /// frames from stretching a real-time step. The default calls receive(0).
-  virtual std::size_t receive_batch(std::span<Frame> out, std::size_t max_reads) noexcept;
+  /// count). The bound is what keeps a flood of unrelated frames from stretching a real-time
+  /// step. The default calls receive(0).
+  virtual BatchResult receive_batch(std::span<Frame> out, std::size_t max_reads) noexcept;
   /// Replaces the receive filters (an empty list accepts everything). Not real-time safe.
   virtual void set_filters(std::vector<Filter> filters) = 0;
   virtual BusStats stats() const noexcept = 0;

@@ -7,8 +7,9 @@
 /// go into TX mailboxes that the controller transmits on its own. ControllerBus gives
 /// an emulated node the same split:
 ///   - pull()  moves the frames the wire has queued into the RX FIFO (the controller's
-///             reception; at most `max_reads` wire reads, so a babbling node cannot
-///             stretch it), before the task runs;
+///             reception: it drains the wire in batches, and stops after `max_reads` wire
+///             reads or `budget_ns` of time, so a babbling node cannot stretch it), before
+///             the task runs;
 ///   - the task calls receive(0) / send() — both O(1) on preallocated FIFOs, no system call;
 ///   - flush() transmits the TX FIFO on the wire, after the task.
 /// The periodic loop times pull()+flush() as I/O and the task alone as TET (docs/hil.md).
@@ -25,15 +26,18 @@
 namespace lash::can {
 
 struct ControllerConfig {
-  std::size_t rx_fifo = 64;     ///< RX FIFO depth [frames]
-  std::size_t tx_fifo = 16;     ///< TX FIFO depth [frames]
-  std::size_t max_reads = 256;  ///< wire reads per pull() (filtered frames included)
+  std::size_t rx_fifo = 64;      ///< RX FIFO depth [frames]
+  std::size_t tx_fifo = 16;      ///< TX FIFO depth [frames]
+  std::size_t max_reads = 8192;  ///< wire reads per pull() at most (filtered frames included)
+  std::int64_t budget_ns = 0;    ///< pull() stops reading once it has taken this long [ns]; 0 = no time limit
 };
 
 struct ControllerStats {
   std::uint64_t rx_overflows = 0;   ///< frames lost to a full RX FIFO
   std::uint64_t tx_overflows = 0;   ///< send() refused: TX FIFO full
   std::uint64_t tx_failures = 0;    ///< frames the wire refused at flush()
+  std::uint64_t rx_reads = 0;       ///< frames/datagrams read from the wire (filtered ones included)
+  std::uint64_t pulls_cut = 0;      ///< pull() calls that stopped at their read or time budget
 };
 
 class ControllerBus final : public Bus {
