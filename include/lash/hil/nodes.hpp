@@ -12,9 +12,11 @@
 ///   Sensor frames missing for N periods (default 3) → 0 mA safe state, logged;
 ///   control resumes when frames return.
 ///
-/// step() is the whole per-sample work of a node, bus I/O included. It is noexcept,
+/// step() is the whole per-sample work of a node on the bus it is given. It is noexcept,
 /// allocation-free (logs are preallocated) and O(1) apart from draining at most
-/// kMaxDrain frames. The real-time loop (rt::PeriodicLoop) and the closed-loop
+/// kMaxDrain frames. In the emulation that bus is an emulated CAN controller
+/// (can/controller_bus.hpp), so step() makes no system call: the socket I/O runs before and
+/// after it, timed apart. The real-time loop (rt::PeriodicLoop) and the closed-loop
 /// simulation (hil/simulate.hpp) call exactly this function, which is why their
 /// traces agree sample for sample.
 ///
