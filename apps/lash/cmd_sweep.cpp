@@ -24,7 +24,36 @@ struct SweepOptions {
   std::string plot;
   bool json = false;
   bool quiet = false;
+  std::vector<std::string> trace;  // RUN FILE
 };
+
+/// `--trace RUN FILE`: run RUN again (runs are deterministic) and write every sample.
+void write_trace(const sweep::Campaign& c, const std::vector<std::string>& arg) {
+  std::size_t idx = 0;
+  try {
+    std::size_t used = 0;
+    const unsigned long long v = std::stoull(arg[0], &used);
+    if (used != arg[0].size()) throw std::invalid_argument(arg[0]);
+    idx = static_cast<std::size_t>(v);
+  } catch (const std::exception&) {
+    throw InputError("", 0, "--trace", "RUN must be a run number (column 'run' of the results), got '" + arg[0] + "'");
+  }
+  if (idx >= c.runs.size())
+    throw InputError("", 0, "--trace",
+                     fmt::format("run {} does not exist: the campaign has runs 0..{}", idx, c.runs.size() - 1));
+  std::vector<sweep::TraceRow> rows;
+  sweep::run_one(c, c.runs[idx], &rows);
+  std::vector<std::vector<double>> cols(10);
+  for (auto& col : cols) col.reserve(rows.size());
+  for (const auto& r : rows) {
+    const double vals[10] = {r.t_s,           r.v,           r.y,           r.y_sim,       r.side.right.a1,
+                             r.side.right.b1, r.side.right.c, r.side.left.a1, r.side.left.b1, r.side.left.c};
+    for (std::size_t i = 0; i < 10; ++i) cols[i].push_back(vals[i]);
+  }
+  std::vector<const std::vector<double>*> ptrs;
+  for (const auto& col : cols) ptrs.push_back(&col);
+  write_columns_csv(arg[1], {"t_s", "v", "y", "y_sim", "a1_r", "b1_r", "c_r", "a1_l", "b1_l", "c_l"}, ptrs);
+}
 
 /// Progress bar on stderr: runs done/total, elapsed, ETA. Redrawn in place on a terminal,
 /// one line per 10 % otherwise (logs stay short).
@@ -104,6 +133,10 @@ void plot_sweep(const sweep::Campaign& c, const std::vector<sweep::RunResult>& r
 
 int run(const SweepOptions& o) {
   const sweep::Campaign c = sweep::load_campaign(o.campaign);
+  if (!o.trace.empty()) {
+    write_trace(c, o.trace);
+    if (!o.quiet) fmt::print(stderr, "trace of run {} -> {}\n", o.trace[0], o.trace[1]);
+  }
   ProgressBar bar(!o.quiet);
   const auto t0 = std::chrono::steady_clock::now();
   const auto results = sweep::run_campaign(c, o.jobs, [&](std::size_t d, std::size_t n) { bar(d, n); });
@@ -153,6 +186,9 @@ Command add_sweep(CLI::App& app) {
   sub->add_option("--plot", o->plot, "Also draw NRMSE against amplitude/frequency per waveform (PNG, gnuplot)");
   sub->add_flag("--json", o->json, "Print the summary as JSON");
   sub->add_flag("-q,--quiet", o->quiet, "No progress bar");
+  sub->add_option("--trace", o->trace,
+                  "RUN FILE: also write every sample of run RUN (t_s, v, y, y_sim, a1/b1/c per side) as CSV")
+      ->expected(2);
   return {sub, [o] { return run(*o); }};
 }
 

@@ -127,15 +127,20 @@ void score_params(RunResult& out, bool compare_tau) {
 /// then the rig advances over [t_k, t_{k+1}] with v(k) held and returns y(k+1).
 template <class Est, class Rig, class Measure, class Simulated>
 void drive(Est& est, Rig& rig, Measure measure, Simulated simulated, Signal& sig, std::size_t n, Score& score,
-           Excitation& ex) {
+           Excitation& ex, double dt_s, std::vector<TraceRow>* trace) {
   auto y = rig.initial_output();
   double v_prev = 0.0;
+  if (trace) trace->reserve(trace->size() + n);
   for (std::size_t k = 0; k < n; ++k) {
     const double v = sig.next();
     const auto [y_est, y_scored] = measure(y);
     est.step(v, y_est);
     ex.observe(est, v_prev);
-    score.add(k, y_scored, simulated(est));
+    const double y_sim = simulated(est);
+    score.add(k, y_scored, y_sim);
+    if (trace)
+      trace->push_back(TraceRow{static_cast<double>(k) * dt_s, v, y_scored, y_sim,
+                                {est.params(Side::right), est.params(Side::left)}});
     v_prev = v;
     y = rig.step(v);
   }
@@ -161,21 +166,21 @@ RunResult finish(const Campaign& c, const RunSpec& r, const Est& est, const Scor
 /// (load_campaign admits no other model for these rigs).
 template <class Rig>
 RunResult run_deadzone_model(const Campaign& c, const RunSpec& r, Rig& rig, Signal& sig, std::size_t n, Score& score,
-                             Excitation& ex) {
+                             Excitation& ex, std::vector<TraceRow>* trace) {
   auto same = [](double y) { return std::pair<double, double>{y, y}; };
   if (c.estimator.model == ModelKind::output_deadzone) {
     OutputDeadzoneEstimator est(c.estimator);
-    drive(est, rig, same, SimOut{}, sig, n, score, ex);
+    drive(est, rig, same, SimOut{}, sig, n, score, ex, c.dt_s, trace);
     return finish(c, r, est, score, ex, true);
   }
   InputDeadzoneEstimator est(c.estimator);
-  drive(est, rig, same, SimOut{}, sig, n, score, ex);
+  drive(est, rig, same, SimOut{}, sig, n, score, ex, c.dt_s, trace);
   return finish(c, r, est, score, ex, true);
 }
 
 }  // namespace
 
-RunResult run_one(const Campaign& c, const RunSpec& r) {
+RunResult run_one(const Campaign& c, const RunSpec& r, std::vector<TraceRow>* trace) {
   Signal sig(signal_of(c, r), c.dt_s);
   const std::size_t n = sample_count(c.duration_s, c.dt_s);
   Score score;
@@ -187,14 +192,14 @@ RunResult run_one(const Campaign& c, const RunSpec& r) {
   switch (c.rig.kind) {
     case rigs::RigKind::motor_cart: {
       rigs::MotorCart rig(c.rig.motor_cart, c.dt_s, r.seed);
-      out = run_deadzone_model(c, r, rig, sig, n, score, ex);
+      out = run_deadzone_model(c, r, rig, sig, n, score, ex, trace);
       out.truth = rig.effective();
       score_params(out, true);
       break;
     }
     case rigs::RigKind::pilot_valve: {
       rigs::PilotValveRig rig(c.rig.pilot_valve, c.dt_s, r.seed);
-      out = run_deadzone_model(c, r, rig, sig, n, score, ex);
+      out = run_deadzone_model(c, r, rig, sig, n, score, ex, trace);
       out.truth = c.rig.pilot_valve.effective(c.dt_s, 0.0);
       score_params(out, false);
       break;
@@ -215,7 +220,7 @@ RunResult run_one(const Campaign& c, const RunSpec& r) {
         return vel;
       };
       CoupledCartsEstimator est(ec);
-      drive(est, rig, pos_vel, sim_vel, sig, n, score, ex);
+      drive(est, rig, pos_vel, sim_vel, sig, n, score, ex, c.dt_s, trace);
       out = finish(c, r, est, score, ex, false);
       out.d = est.deadband();
       out.d_identified = std::isfinite(out.d) && out.d >= 0.0;

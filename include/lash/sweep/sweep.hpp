@@ -47,8 +47,19 @@ struct RunResult {
   bool good(double threshold) const noexcept { return nrmse < threshold; }
 };
 
-/// Runs one run from scratch (deterministic: same campaign and spec → same bits).
-RunResult run_one(const Campaign& c, const RunSpec& run);
+/// One sample of a traced run: what the estimator saw and gave, for looking into a run.
+struct TraceRow {
+  double t_s = 0.0;       ///< time of the sample [s]
+  double v = 0.0;         ///< input [rig input unit]
+  double y = 0.0;         ///< scored output (coupled carts: free-cart velocity) [output unit]
+  double y_sim = 0.0;     ///< the model's free-run output scored against y
+  PerSide<SideParams> side;  ///< the estimator's parameters after the sample (NaN while not identified)
+};
+
+/// Runs one run from scratch (deterministic: same campaign and spec → same bits). With
+/// `trace`, every sample is appended to it (the NRMSE over the window is computed from
+/// exactly these y and y_sim).
+RunResult run_one(const Campaign& c, const RunSpec& run, std::vector<TraceRow>* trace = nullptr);
 
 /// Called from the coordinating thread with (runs done, total) about five times a second
 /// and once at the end.
