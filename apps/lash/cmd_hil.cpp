@@ -230,10 +230,7 @@ int run_slave(const SlaveOptions& o) {
   // The slave's grid sits half a period after the master's (see nodes.hpp). The loop and its
   // buffers exist already, so the first step is not delayed by allocation or page faults.
   loop.set_start_ns(t_connect + lc.period_ns / 2);
-  rt::PeriodicLoop& run_loop = loop;
-  const double epoch = realtime_now_s() - static_cast<double>(rt::monotonic_ns() - lc.start_ns) * 1e-9;
-  (void)epoch;
-  const rt::RunResult r = run_loop.run_with_io(
+  const rt::RunResult r = loop.run_with_io(
       [&]() noexcept { ctl.pull(); },
       [&](std::size_t, std::int64_t t_ns) noexcept {
         slave.step(ctl, static_cast<double>(t_ns) * 1e-9);
@@ -243,7 +240,7 @@ int run_slave(const SlaveOptions& o) {
 
   // Logs (after the run; the loop stopped at a step boundary).
   const auto log = slave.log();
-  const auto rec = run_loop.records();
+  const auto rec = loop.records();
   std::vector<double> c_step, c_t, c_cnt, c_fresh, c_i, c_p, c_y, c_raw, c_tet, c_io, c_lat;
   for (std::size_t i = 0; i < log.size(); ++i) {
     c_step.push_back(log[i].step);
@@ -262,7 +259,7 @@ int run_slave(const SlaveOptions& o) {
                     {"step", "t_s", "command_counter", "command_fresh", "current_mA", "pressure_kPa", "measured_kPa",
                      "pilot_raw", "tet_us", "io_us", "wake_latency_us"},
                     {&c_step, &c_t, &c_cnt, &c_fresh, &c_i, &c_p, &c_y, &c_raw, &c_tet, &c_io, &c_lat});
-  json j = loop_json(run_loop, r, warnings);
+  json j = loop_json(loop, r, warnings);
   const auto& c = slave.commands();
   const auto bs = bus->stats();
   j["frames"] = {{"sent", slave.frames_sent()},     {"received", c.received}, {"late", c.late},
@@ -273,12 +270,12 @@ int run_slave(const SlaveOptions& o) {
   j["dto_replies"] = slave.dto_replies();
   j["seed"] = s.plant.seed;
   if (!o.stats.empty()) write_json(o.stats, j);
-  const auto tet = run_loop.tet_us();
+  const auto tet = loop.tet_us();
   fmt::print(stderr,
              "lash hil slave: {} steps ({}), TET mean {:.2f} us max {:.2f} us (CAN I/O mean {:.2f} us), overruns {}, "
              "commands received {} "
              "late {} lost {}\n",
-             r.steps, rt::to_string(r.reason), tet.mean, tet.max, run_loop.io_us().mean, r.overruns, c.received, c.late,
+             r.steps, rt::to_string(r.reason), tet.mean, tet.max, loop.io_us().mean, r.overruns, c.received, c.late,
              c.lost);
   return kExitOk;
 }

@@ -30,6 +30,7 @@
 #include "bus_internal.hpp"
 #include "lash/can/datagram.hpp"
 #include "lash/io/error.hpp"
+#include "lash/rt/periodic.hpp"
 
 namespace lash::can::detail {
 namespace {
@@ -182,12 +183,12 @@ class UdpBus final : public Bus {
   }
 
   std::optional<Frame> receive(std::chrono::nanoseconds timeout) noexcept override {
-    const std::int64_t deadline_ns = monotonic_now_ns() + timeout.count();
+    const std::int64_t deadline_ns = rt::monotonic_ns() + timeout.count();
     // A poll (timeout 0) reads at most kPollReads datagrams, so a flood of filtered frames
     // cannot keep it looping; a wait is bounded by its deadline.
     std::size_t reads = 0;
     for (;;) {
-      const std::int64_t left_ns = deadline_ns - monotonic_now_ns();
+      const std::int64_t left_ns = deadline_ns - rt::monotonic_ns();
       if (timeout.count() <= 0 && reads >= kPollReads) return std::nullopt;
       pollfd p{rx_, POLLIN, 0};
       timespec tmo{};
@@ -282,12 +283,6 @@ class UdpBus final : public Bus {
       msg.msg_controllen = sizeof control;
     }
   };
-
-  static std::int64_t monotonic_now_ns() noexcept {
-    timespec now{};
-    clock_gettime(CLOCK_MONOTONIC, &now);
-    return now.tv_sec * 1000000000LL + now.tv_nsec;
-  }
 
   /// Decodes one received datagram of n bytes into f; false (and counted) for our own
   /// frames, malformed or oversized datagrams and frames the filters drop.

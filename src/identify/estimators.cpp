@@ -312,8 +312,7 @@ void CoupledCartsEstimator::refresh(int i) noexcept {
   const bool stable =
       std::isfinite(e[0]) && std::isfinite(e[1]) && std::isfinite(e[2]) && e[0] > -1.0 && e[0] < 0.0;
   const double c = stable ? -e[2] / (1.0 + e[0]) : kNaN;  // eq. 38: e = −c(1 + a1)
-  const double span = vhi_[i] - vlo_[i];
-  const bool exciting = span > 1e-9 * std::max(1.0, std::max(std::fabs(vhi_[i]), std::fabs(vlo_[i])));
+  const bool exciting = vrange_[i].several();
   p.identified = rls_[i].updates() >= cfg_.min_updates && stable && std::isfinite(c) &&
                  (i == 0 ? c >= 0.0 : c <= 0.0) && exciting;
   if (p.identified) {
@@ -358,8 +357,7 @@ double CoupledCartsEstimator::step(double v, double y) noexcept {
   if (dir != 0 && dir == dir1_ && dir == dir2_ && steady) {
     const int i = dir > 0 ? 0 : 1;
     vel_pred = rls_[i].update({-vel1, v1, 1.0}, vel);
-    vlo_[i] = std::min(vlo_[i], v1);
-    vhi_[i] = std::max(vhi_[i], v1);
+    vrange_[i].add(v1);
     refresh(i);
   } else if (dir1_ != 0) {
     vel_pred = rls_[dir1_ > 0 ? 0 : 1].predict({-vel1, v1, 1.0});

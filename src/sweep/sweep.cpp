@@ -34,24 +34,19 @@ struct Score {
 
 /// Range of v(k−1) over the samples on which each side's RLS updated (excitation check).
 struct Excitation {
-  PerSide<double> vmin = PerSide<double>::both(std::numeric_limits<double>::infinity());
-  PerSide<double> vmax = PerSide<double>::both(-std::numeric_limits<double>::infinity());
+  PerSide<detail::ValueRange> range{};
   PerSide<std::uint64_t> last{};
   template <class Est>
   void observe(const Est& est, double v_prev) noexcept {
     for (Side s : {Side::right, Side::left}) {
       const auto u = est.updates(s);
       if (u != last[s]) {
-        vmin[s] = std::min(vmin[s], v_prev);
-        vmax[s] = std::max(vmax[s], v_prev);
+        range[s].add(v_prev);
         last[s] = u;
       }
     }
   }
-  bool exciting(Side s) const noexcept {
-    const double span = vmax[s] - vmin[s];
-    return span > 1e-9 * std::max(1.0, std::max(std::fabs(vmax[s]), std::fabs(vmin[s])));
-  }
+  bool exciting(Side s) const noexcept { return range[s].several(); }
 };
 
 SignalSpec signal_of(const Campaign& c, const RunSpec& r) {

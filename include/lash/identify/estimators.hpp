@@ -10,6 +10,7 @@
 /// is NaN — never a huge number.
 ///
 /// Regression (SPEC A4): φ(k) = [−y(k−1), v(k−1), 1], η = [a1, b1, e].
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -37,6 +38,18 @@ constexpr double deadzone(double x, double cl, double cr) noexcept {
   return x > cr ? x - cr : (x < cl ? x - cl : 0.0);
 }
 constexpr int side_index(Side s) noexcept { return s == Side::right ? 0 : 1; }
+/// The range of the values one regressor took (excitation check: a constant input makes b1 and
+/// the offset e inseparable — only b1·v + e is determined).
+struct ValueRange {
+  double lo = std::numeric_limits<double>::infinity();
+  double hi = -std::numeric_limits<double>::infinity();
+  void add(double x) noexcept {
+    lo = std::min(lo, x);
+    hi = std::max(hi, x);
+  }
+  /// More than one value (beyond rounding) was seen.
+  bool several() const noexcept { return hi - lo > 1e-9 * std::max(1.0, std::max(std::fabs(hi), std::fabs(lo))); }
+};
 /// Fixed ring of the last 64 values (instrument history).
 struct History {
   std::array<double, 64> buf{};
@@ -280,8 +293,7 @@ class CoupledCartsEstimator {
   std::array<SideParams, 2> p_{};
   std::array<double, 2> sa1_{}, sb1_{}, sc_{};  // last identified set per side (free run)
   std::array<bool, 2> valid_{};                   // side identified at least once
-  std::array<double, 2> vlo_{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
-  std::array<double, 2> vhi_{-std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+  std::array<detail::ValueRange, 2> vrange_{};  // v(k−1) over each side's updates
   double vel1_ = 0.0, v1_ = 0.0, vraw1_ = 0.0, y1_ = 0.0;
   int dir1_ = 0, dir2_ = 0, sim_last_ = 0;
   double x_ = 0.0, wdot_ = 0.0, w_ = 0.0, ydb_ = 0.0;
