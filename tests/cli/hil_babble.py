@@ -53,22 +53,15 @@ print(f"babbler sent {sent[0]} frames; master filtered {j['frames']['bus_filtere
       f"max {j['io_us']['max']:.1f} us (reads {j['can_controller']['rx_reads']}, pulls cut at the 1 ms budget "
       f"{j['can_controller']['pulls_cut']}), sensor frames late {j['frames']['late']} lost {j['frames']['lost']}")
 assert sent[0] > 3000 and j["frames"]["bus_filtered"] > 1000, (sent[0], j["frames"])
-# The babbler must not make the master's work miss deadlines: every step's cycle (CAN I/O + TET)
-# stays far inside the 5 ms step — the reception is bounded by its time budget (a fifth of the
-# step) plus one batch. An overrun can then only come from a late wake-up (the host taking the
-# vCPU away for milliseconds, which `lash hil latency` shows on an empty loop too): each one
-# must be explained by its step's wake-up latency, and they must stay rare.
+# The babbler must not make the master miss deadlines: no overrun, and every step's cycle
+# (CAN I/O + TET) stays far inside the 5 ms step — the reception is bounded by its time budget
+# (a fifth of the step) plus one batch.
+assert j["overruns"] == 0, j["overrun_events"][:5]
+assert j["tet_us"]["max"] < 5000
 m = hil_netns.read_csv(f"{out}/master.csv")
 cycle = [t + i for t, i in zip(m["tet_us"], m["io_us"])]
 assert max(cycle) < 2500, max(cycle)
 assert j["io_us"]["max"] < 2500, j["io_us"]
-for ev in j["overrun_events"]:
-    k = ev["step"]
-    assert m["wake_latency_us"][k] + cycle[k] > 5000 and cycle[k] < 2500, (ev, m["wake_latency_us"][k], cycle[k])
-assert j["overruns"] <= 2, j["overrun_events"][:5]
-if j["overruns"]:
-    print(f"note: {j['overruns']} overrun(s), each from a wake-up stall: "
-          f"{[round(m['wake_latency_us'][e['step']]) for e in j['overrun_events']]} us")
 # A flood can fill the UDP receive buffer, so the kernel may drop sensor frames too (on a real
 # CAN bus an id-0x050 babbler would even win arbitration). Such losses are counted, never
 # absorbed: every sensor counter value up to the last one seen was received or counted lost.
