@@ -53,15 +53,20 @@ print(f"babbler sent {sent[0]} frames; master filtered {j['frames']['bus_filtere
       f"max {j['io_us']['max']:.1f} us (reads {j['can_controller']['rx_reads']}, pulls cut at the 1 ms budget "
       f"{j['can_controller']['pulls_cut']}), sensor frames late {j['frames']['late']} lost {j['frames']['lost']}")
 assert sent[0] > 3000 and j["frames"]["bus_filtered"] > 1000, (sent[0], j["frames"])
-# The babbler must not make the master miss deadlines: no overrun, and every step's cycle
-# (CAN I/O + TET) stays far inside the 5 ms step — the reception is bounded by its time budget
-# (a fifth of the step) plus one batch.
-assert j["overruns"] == 0, j["overrun_events"][:5]
-assert j["tet_us"]["max"] < 5000
+# The babbler must not make the master miss deadlines: every step's cycle (CAN I/O + TET) stays
+# far inside the 5 ms step -- the reception is bounded by its time budget (a fifth of the step)
+# plus one batch. A step overruns when wake-up latency + cycle > 5 ms; with every cycle < 2.5 ms an
+# overrun can only come from a wake-up stall of the host (> 2.5 ms, seen on shared CI machines),
+# never from lash's own work under the flood: each overrun must be such a stall.
 m = hil_netns.read_csv(f"{out}/master.csv")
 cycle = [t + i for t, i in zip(m["tet_us"], m["io_us"])]
 assert max(cycle) < 2500, max(cycle)
 assert j["io_us"]["max"] < 2500, j["io_us"]
+assert j["tet_us"]["max"] < 2500, j["tet_us"]
+row = {int(st): k for k, st in enumerate(m["step"])}
+for ev in j["overrun_events"]:
+    k = row[int(ev["step"])]
+    assert m["wake_latency_us"][k] > 2500 - 1e-6, (ev, m["wake_latency_us"][k], cycle[k])
 # A flood can fill the UDP receive buffer, so the kernel may drop sensor frames too (on a real
 # CAN bus an id-0x050 babbler would even win arbitration). Such losses are counted, never
 # absorbed: every sensor counter value up to the last one seen was received or counted lost.
