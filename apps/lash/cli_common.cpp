@@ -16,6 +16,9 @@ int guarded(const std::function<int()>& fn) {
   } catch (const std::invalid_argument& e) {
     fmt::print(stderr, "lash: error: {}\n", e.what());
     return kExitBadInput;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "lash: error: {}\n", e.what());
+    return kExitFailed;
   }
 }
 

@@ -1,6 +1,9 @@
 #include "lash/hil/report.hpp"
 
 #include <cmath>
+#include <set>
+
+#include "json_parts.hpp"
 
 namespace lash::hil {
 
@@ -51,6 +54,181 @@ SimulationDiff compare_with_simulation(const std::vector<std::int64_t>& control_
     d.max_abs_diff_mA = std::max(d.max_abs_diff_mA, di);
   }
   return d;
+}
+
+SimulationDiff compare_with_simulation(const std::vector<MasterStepLog>& emulated,
+                                       const std::vector<MasterStepLog>& simulated) {
+  std::vector<std::int64_t> m;
+  std::vector<double> y, i;
+  for (const auto& l : emulated) {
+    m.push_back(l.control_step);
+    y.push_back(l.measured_kPa);
+    i.push_back(l.current_mA);
+  }
+  return compare_with_simulation(m, y, i, simulated);
+}
+
+std::optional<StepResponse> step_response(const std::vector<double>& reference_kPa, double dt_s,
+                                          const std::vector<double>& pressure_kPa,
+                                          const std::vector<double>* measured_kPa) {
+  const std::optional<StepWindow> w = find_step(reference_kPa, dt_s);
+  if (!w || w->end > pressure_kPa.size() || (measured_kPa != nullptr && w->end > measured_kPa->size()))
+    return std::nullopt;
+  const auto b = static_cast<std::ptrdiff_t>(w->begin), e = static_cast<std::ptrdiff_t>(w->end);
+  std::vector<double> t;
+  for (std::size_t i = w->begin; i < w->end; ++i) t.push_back(static_cast<double>(i) * dt_s);
+  StepResponse r;
+  r.window = *w;
+  r.plant = step_metrics(t, std::vector<double>(pressure_kPa.begin() + b, pressure_kPa.begin() + e), w->t_step_s,
+                         w->y0, w->y1);
+  if (measured_kPa != nullptr)
+    r.measured = step_metrics(t, std::vector<double>(measured_kPa->begin() + b, measured_kPa->begin() + e),
+                              w->t_step_s, w->y0, w->y1);
+  return r;
+}
+
+std::size_t off_schedule_steps(const std::vector<MasterStepLog>& master, const std::vector<SlaveStepLog>& slave,
+                               std::int64_t control_steps) {
+  std::set<std::int64_t> off;
+  for (const auto& l : master)
+    if (l.control_step >= 0 &&
+        (!l.sensor_fresh || l.sensor_counter != static_cast<std::uint16_t>(l.control_step)))
+      off.insert(l.control_step);
+  for (const auto& l : slave) {
+    const auto s = static_cast<std::int64_t>(l.step);
+    if (s > 0 && s < control_steps &&
+        (!l.command_fresh || l.command_counter != static_cast<std::uint16_t>(s - 1)))
+      off.insert(s);
+  }
+  return off.size();
+}
+
+NodeFigures node_figures(const NodeStats& stats, const LoopTrace& loop) {
+  NodeFigures f;
+  f.tet_us = rt::tet_us(loop.records);
+  f.io_us = rt::io_us(loop.records);
+  f.cycle_us = rt::cycle_us(loop.records);
+  f.wake_latency_us = rt::wake_latency_us(loop.records);
+  f.steps = stats.result.steps;
+  f.overruns = stats.result.overruns;
+  f.frames = stats.frames;
+  f.warnings = loop.warnings;
+  f.dma_latency_held = stats.dma_latency_held;
+  return f;
+}
+
+void make_run_report(RunReport& rep, const MasterRun* master, const std::vector<SlaveRun>& slaves,
+                     const std::vector<MasterStepLog>& simulated) {
+  rep.have_master = master != nullptr;
+  rep.have_slave = !slaves.empty();
+  rep.frames = {};
+  auto add = [&](const FrameStats& f) {
+    rep.frames.sent += f.sent;
+    rep.frames.received += f.received;
+    rep.frames.late += f.late;
+    rep.frames.lost += f.lost;
+  };
+  for (const auto& s : slaves) add(s.stats.frames);
+  if (rep.have_slave) rep.slave = node_figures(slaves[0].stats, slaves[0].loop);
+  if (!master) return;
+  add(master->stats.frames);
+  rep.master = node_figures(master->stats, master->loop);
+  rep.handshake_s = master->stats.handshake_s;
+  rep.control_steps = master->stats.control_steps;
+  rep.events = master->events;
+  rep.vs_simulation = compare_with_simulation(master->log, simulated);
+  rep.off_schedule = off_schedule_steps(master->log, rep.have_slave ? slaves[0].log : std::vector<SlaveStepLog>{},
+                                        rep.control_steps);
+  // Step response on the emulated plant pressure (slave step s = control step m).
+  if (rep.have_slave) {
+    std::vector<double> ref, p, y;
+    for (const auto& l : master->log)
+      if (l.control_step >= 0) ref.push_back(l.reference_kPa);
+    for (const auto& l : slaves[0].log) {
+      p.push_back(l.pressure_kPa);
+      y.push_back(l.measured_kPa);
+    }
+    rep.step = step_response(ref, rep.step_s, p, &y);
+  }
+}
+
+namespace {
+using nlohmann::json;
+
+json node_json(const NodeFigures& f) {
+  return json{{"tet_us", detail::summary_json(f.tet_us)},
+              {"io_us", detail::summary_json(f.io_us)},
+              {"cycle_us", detail::summary_json(f.cycle_us)},
+              {"wake_latency_us", detail::summary_json(f.wake_latency_us)},
+              {"overruns", f.overruns},
+              {"steps", f.steps},
+              {"frames", detail::frames_json(f.frames)},
+              {"warnings", f.warnings},
+              {"dma_latency_held", f.dma_latency_held}};
+}
+
+json exit_json(const NodeExit& e) {
+  json j{{"exited", e.exited}, {"status", e.status}, {"t_s", e.t_s}};
+  if (e.signal) j["signal"] = e.signal;
+  return j;
+}
+
+json metrics_json(const StepMetrics& m) {
+  return json{{"rise_s", m.rise_s}, {"settling_s", m.settling_s}, {"overshoot_pct", m.overshoot_pct}};
+}
+}  // namespace
+
+std::string run_report_json(const RunReport& r) {
+  json out;
+  out["duration_s"] = r.duration_s;
+  out["step_ms"] = r.step_s * 1e3;
+  out["reference"] = r.reference;
+  out["isolation"] = r.isolation;
+  out["bus"] = r.bus;
+  out["interrupted"] = r.interrupted;
+  if (r.interrupted) out["interrupt_signal"] = r.interrupt_signal;
+  out["master_exit"] = exit_json(r.master_exit);
+  json se = json::array();
+  for (const auto& e : r.slave_exits) se.push_back(exit_json(e));
+  out["slave_exits"] = se;
+  json rs = json::array();
+  for (const auto& g : r.restarts) {
+    json j{{"died", exit_json(g.died)}, {"restarted_s", g.restarted_s}};
+    if (g.restarted_s >= 0) j["gap_s"] = g.gap_s();
+    rs.push_back(j);
+  }
+  out["slave_restarts"] = rs;
+  if (r.have_master) {
+    out["master"] = node_json(r.master);
+    out["master"]["handshake_s"] = r.handshake_s;
+    json ev = json::array();
+    for (const auto& e : r.events) ev.push_back({{"step", e.step}, {"t_s", e.t_s}, {"event", to_string(e.kind)}});
+    out["master"]["events"] = ev;
+    out["master"]["control_steps"] = r.control_steps;
+  }
+  if (r.have_slave) out["slave"] = node_json(r.slave);
+  out["frames"] = {{"sent", r.frames.sent}, {"received", r.frames.received}, {"late", r.frames.late},
+                   {"lost", r.frames.lost}};
+  json step = json::object();
+  if (r.step) {
+    const auto& w = r.step->window;
+    step = metrics_json(r.step->plant);
+    step["t_step_s"] = w.t_step_s;
+    step["from_kPa"] = w.y0;
+    step["to_kPa"] = w.y1;
+    step["signal"] = "plant pressure (noise-free, slave log)";
+    if (r.step->measured) step["measured"] = metrics_json(*r.step->measured);
+  }
+  out["step_response"] = step;
+  if (r.have_master) {
+    out["max_abs_diff_vs_simulation_kPa"] = r.vs_simulation.max_abs_diff_kPa;
+    out["max_abs_diff_vs_simulation_mA"] = r.vs_simulation.max_abs_diff_mA;
+    out["compared_steps"] = r.vs_simulation.compared;
+    if (r.vs_simulation.first_diff_step) out["first_diff_control_step"] = *r.vs_simulation.first_diff_step;
+    out["off_schedule_steps"] = r.off_schedule;
+  }
+  out["out_dir"] = r.out_dir;
+  return out.dump(2) + "\n";
 }
 
 }  // namespace lash::hil

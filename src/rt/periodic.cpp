@@ -125,25 +125,27 @@ std::vector<std::string> PeriodicLoop::apply_realtime_settings() {
   return warnings;
 }
 
+namespace {
 template <class Get>
-Summary PeriodicLoop::summarize_us(Get get) const {
+Summary summarize_us(std::span<const StepRecord> records, Get get) {
   std::vector<double> v;
-  v.reserve(n_records_);
-  for (const auto& r : records()) v.push_back(static_cast<double>(get(r)) * 1e-3);
+  v.reserve(records.size());
+  for (const auto& r : records) v.push_back(static_cast<double>(get(r)) * 1e-3);
   return summarize(v);
 }
+}  // namespace
 
-Summary PeriodicLoop::tet_us() const {
-  return summarize_us([](const StepRecord& r) { return r.tet_ns; });
+Summary tet_us(std::span<const StepRecord> records) {
+  return summarize_us(records, [](const StepRecord& r) { return r.tet_ns; });
 }
-Summary PeriodicLoop::wake_latency_us() const {
-  return summarize_us([](const StepRecord& r) { return r.wake_latency_ns; });
+Summary wake_latency_us(std::span<const StepRecord> records) {
+  return summarize_us(records, [](const StepRecord& r) { return r.wake_latency_ns; });
 }
-Summary PeriodicLoop::io_us() const {
-  return summarize_us([](const StepRecord& r) { return r.io_ns; });
+Summary io_us(std::span<const StepRecord> records) {
+  return summarize_us(records, [](const StepRecord& r) { return r.io_ns; });
 }
-Summary PeriodicLoop::cycle_us() const {
-  return summarize_us([](const StepRecord& r) { return r.io_ns + r.tet_ns; });
+Summary cycle_us(std::span<const StepRecord> records) {
+  return summarize_us(records, [](const StepRecord& r) { return r.io_ns + r.tet_ns; });
 }
 
 }  // namespace lash::rt

@@ -6,9 +6,13 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
+#include "lash/control/step_metrics.hpp"
+#include "lash/hil/node_run.hpp"
 #include "lash/hil/nodes.hpp"
+#include "lash/rt/periodic.hpp"
 
 namespace lash::hil {
 
@@ -35,5 +39,81 @@ struct SimulationDiff {
 SimulationDiff compare_with_simulation(const std::vector<std::int64_t>& control_step,
                                        const std::vector<double>& measured_kPa, const std::vector<double>& current_mA,
                                        const std::vector<MasterStepLog>& simulated);
+/// The same over the master's own log.
+SimulationDiff compare_with_simulation(const std::vector<MasterStepLog>& emulated,
+                                       const std::vector<MasterStepLog>& simulated);
+
+/// Step-response figures of a trace sampled at dt_s (sample i at t = i·dt_s): the first
+/// reference step (find_step) and lash::step_metrics of the plant pressure in its window,
+/// and of the measured pressure when given. The one place both `hil run` and `hil simulate` get them.
+struct StepResponse {
+  StepWindow window;
+  StepMetrics plant;                     ///< of the noise-free plant pressure
+  std::optional<StepMetrics> measured;   ///< of the sensor reading
+};
+std::optional<StepResponse> step_response(const std::vector<double>& reference_kPa, double dt_s,
+                                          const std::vector<double>& pressure_kPa,
+                                          const std::vector<double>* measured_kPa = nullptr);
+
+/// Control steps that consumed another frame than the one meant for them: master step m must
+/// use the sensor frame of slave step m (fresh, counter m), slave step s (0 < s < control_steps)
+/// the command of master step s − 1 (fresh, counter s − 1), counters compared modulo 2¹⁶.
+/// Late frames, lost frames or a node running late show up here.
+std::size_t off_schedule_steps(const std::vector<MasterStepLog>& master, const std::vector<SlaveStepLog>& slave,
+                               std::int64_t control_steps);
+
+/// Loop figures of one node [µs] and its counters.
+struct NodeFigures {
+  rt::Summary tet_us, io_us, cycle_us, wake_latency_us;
+  std::size_t steps = 0, overruns = 0;
+  FrameStats frames;
+  std::vector<std::string> warnings;
+  bool dma_latency_held = false;
+};
+NodeFigures node_figures(const NodeStats& stats, const LoopTrace& loop);
+
+/// How a node process ended, seen by the session.
+struct NodeExit {
+  bool exited = false;      ///< false: still running when the session ended (should not happen)
+  int status = 0;           ///< exit code, or 128 + signal number
+  int signal = 0;           ///< the signal that killed it (0 = exited normally)
+  double t_s = 0.0;         ///< when, since the session started [s]
+};
+
+/// A slave that died and the watchdog restarted (--restart-slave).
+struct SlaveRestart {
+  NodeExit died;
+  double restarted_s = -1.0;  ///< when the new slave was ready [s since start]; −1 = not restarted
+  double gap_s() const { return restarted_s >= 0 ? restarted_s - died.t_s : -1.0; }
+};
+
+/// What `lash hil run` reports (report.json): computed from the nodes' runs in memory.
+struct RunReport {
+  // The session (filled by hil::Session).
+  double duration_s = 0.0, step_s = 0.0;
+  std::string reference, isolation, bus, out_dir;
+  bool interrupted = false;
+  int interrupt_signal = 0;
+  NodeExit master_exit;
+  std::vector<NodeExit> slave_exits;      ///< one per slave process, in start order
+  std::vector<SlaveRestart> restarts;
+  // Computed by make_run_report.
+  bool have_master = false, have_slave = false;
+  NodeFigures master, slave;              ///< slave: the first slave process
+  double handshake_s = -1.0;
+  std::int64_t control_steps = 0;
+  std::vector<MasterEvent> events;
+  FrameStats frames;                      ///< sent/received/late/lost summed over master + every slave
+  std::optional<StepResponse> step;
+  SimulationDiff vs_simulation;           ///< against the ideal-schedule simulation
+  std::size_t off_schedule = 0;
+};
+
+/// Fills the computed part of `report` from the master's run, the slaves' runs (first = the one
+/// started with the master) and the simulation of the same control steps (simulate_bench).
+void make_run_report(RunReport& report, const MasterRun* master, const std::vector<SlaveRun>& slaves,
+                     const std::vector<MasterStepLog>& simulated);
+/// report.json text (fields documented in docs/hil.md).
+std::string run_report_json(const RunReport& report);
 
 }  // namespace lash::hil

@@ -69,6 +69,12 @@ struct Summary {
 /// mean/min/max/std and the 99th percentile (nearest rank: the ⌈0.99·n⌉-th smallest).
 Summary summarize(std::span<const double> values);
 
+/// The same statistics over records [µs] (what PeriodicLoop's members return for its own).
+Summary tet_us(std::span<const StepRecord> records);
+Summary wake_latency_us(std::span<const StepRecord> records);
+Summary io_us(std::span<const StepRecord> records);
+Summary cycle_us(std::span<const StepRecord> records);
+
 enum class StopReason : std::uint8_t { completed, requested, step_returned_false, overruns };
 const char* to_string(StopReason r) noexcept;
 
@@ -159,14 +165,12 @@ class PeriodicLoop {
   std::span<const OverrunEvent> overruns() const noexcept { return {overruns_.data(), n_overruns_}; }
   /// Statistics over the recorded steps [µs]: TET, wake-up latency, I/O time, and the cycle
   /// (I/O + TET: what the deadline is checked against, wake-up latency excluded).
-  Summary tet_us() const;
-  Summary wake_latency_us() const;
-  Summary io_us() const;
-  Summary cycle_us() const;
+  Summary tet_us() const { return rt::tet_us(records()); }
+  Summary wake_latency_us() const { return rt::wake_latency_us(records()); }
+  Summary io_us() const { return rt::io_us(records()); }
+  Summary cycle_us() const { return rt::cycle_us(records()); }
 
  private:
-  template <class Get>
-  Summary summarize_us(Get get) const;
   LoopConfig cfg_;
   std::int64_t start_ns_ = 0;
   std::vector<StepRecord> records_;

@@ -1,0 +1,39 @@
+#pragma once
+// lash hil: shared option handling of the hil subcommands (parsing only; the work is in src/hil).
+#include <string>
+
+#include "cli_common.hpp"
+#include "lash/hil/node_run.hpp"
+#include "lash/hil/settings.hpp"
+
+namespace lash::cli::hilcli {
+
+/// Options every real-time subcommand takes.
+struct CommonOptions {
+  std::string config;
+  std::string bus;
+  double step_ms = 0.0;  // 0 = from the settings file
+  int fifo = 0;
+  int cpu = -1;
+  double spin_us = 0.0;
+  bool lock_memory = false;
+  bool no_dma_latency = false;
+  std::string overrun_policy = "tolerate";
+  std::size_t max_overruns = 10;
+};
+
+void add_common(CLI::App* sub, CommonOptions& o);
+/// The settings file (default config/hil/bench.toml) with --bus and --step-ms applied.
+hil::BenchSettings load_settings(const CommonOptions& o);
+/// Validated loop options (InputError naming the option).
+hil::LoopOptions loop_options(const CommonOptions& o, const hil::BenchSettings& s);
+/// The settings file the options name (for the node processes of `hil run`).
+std::string settings_path(const CommonOptions& o);
+
+/// --duration: positive, and at most kMaxSteps steps of the shortest step.
+CLI::Option* add_duration(CLI::App* sub, double& value, const std::string& what);
+
+void add_hil_nodes(CLI::App* hil, std::function<int()>& run_selected);
+void add_hil_run(CLI::App* hil, std::function<int()>& run_selected);
+
+}  // namespace lash::cli::hilcli

@@ -1,0 +1,190 @@
+// lash hil run / simulate: the two-process session with its report, and the simulation.
+#include <cstdio>
+#include <filesystem>
+
+#include <fmt/core.h>
+
+#include "cmd_hil.hpp"
+#include "lash/hil/report.hpp"
+#include "lash/hil/session.hpp"
+#include "lash/hil/simulate.hpp"
+
+namespace lash::cli::hilcli {
+namespace {
+
+struct RunOptions {
+  CommonOptions common;
+  double duration = 5.0;
+  std::string reference = "step:from=500,to=1500,time=1";
+  std::string out_dir = "hil-out";
+  bool json_out = false;
+  bool no_isolate = false;
+  bool restart_slave = false;
+  std::int64_t seed = -1;
+  int slave_cpu = -1;
+};
+
+struct SimulateOptions {
+  std::string config;
+  double step_ms = 0.0;
+  double duration = 5.0;
+  std::string reference = "step:from=500,to=1500,time=1";
+  std::int64_t seed = -1;
+  std::string out = "hil_sim.csv";
+};
+
+void print_node(const char* who, const hil::NodeFigures& n) {
+  fmt::print("{:<7} TET [us] mean {:7.3f} min {:7.3f} max {:8.3f} std {:7.3f} p99 {:8.3f} | CAN I/O [us] mean {:7.2f} "
+             "p99 {:8.2f} | cycle [us] mean {:7.2f} max {:8.2f}\n",
+             who, n.tet_us.mean, n.tet_us.min, n.tet_us.max, n.tet_us.std, n.tet_us.p99, n.io_us.mean, n.io_us.p99,
+             n.cycle_us.mean, n.cycle_us.max);
+  fmt::print("{:<7} wake-up latency [us] mean {:7.2f} p99 {:8.2f} max {:8.2f} | overruns {} | cpu_dma_latency {}\n", "",
+             n.wake_latency_us.mean, n.wake_latency_us.p99, n.wake_latency_us.max, n.overruns,
+             n.dma_latency_held ? "held at 0" : "not held");
+}
+
+void print_exit(const char* who, const hil::NodeExit& e) {
+  if (e.signal)
+    fmt::print("{} killed by signal {} at t = {:.3f} s\n", who, e.signal, e.t_s);
+  else if (e.status != 0)
+    fmt::print("{} exited with status {} at t = {:.3f} s\n", who, e.status, e.t_s);
+}
+
+void print_report(const hil::RunReport& r) {
+  fmt::print("lash hil run: {} s at {} ms, reference {}, bus {} in a {}\n", format_double(r.duration_s),
+             format_double(r.step_s * 1e3), r.reference, r.bus, r.isolation);
+  if (r.interrupted) fmt::print("INTERRUPTED by signal {}: the logs end where the nodes stopped\n", r.interrupt_signal);
+  print_exit("master", r.master_exit);
+  for (const auto& e : r.slave_exits) print_exit("slave", e);
+  for (const auto& g : r.restarts)
+    if (g.restarted_s >= 0)
+      fmt::print("slave died at t = {:.3f} s and was restarted at t = {:.3f} s (gap {:.3f} s)\n", g.died.t_s,
+                 g.restarted_s, g.gap_s());
+  if (!r.have_master) {
+    fmt::print("no master log (the master handed nothing over)\n");
+    return;
+  }
+  fmt::print("CCP handshake {:.4f} s; {} control steps\n", r.handshake_s, r.control_steps);
+  print_node("master", r.master);
+  if (r.have_slave) print_node("slave", r.slave);
+  fmt::print("frames: sent {} received {} late {} lost {}\n", r.frames.sent, r.frames.received, r.frames.late,
+             r.frames.lost);
+  if (r.step) {
+    const auto& w = r.step->window;
+    const auto& p = r.step->plant;
+    fmt::print("step {} -> {} kPa at {} s: 90% rise {:.4f} s, 10% settling {:.4f} s, overshoot {:.1f} % (plant pressure",
+               format_double(w.y0), format_double(w.y1), format_double(w.t_step_s), p.rise_s, p.settling_s,
+               p.overshoot_pct);
+    if (r.step->measured)
+      fmt::print("; measured: {:.4f} s, {:.4f} s, {:.1f} %", r.step->measured->rise_s, r.step->measured->settling_s,
+                 r.step->measured->overshoot_pct);
+    fmt::print(")\n");
+  } else {
+    fmt::print("step response: no reference step held >= 0.5 s in this run\n");
+  }
+  fmt::print("max |emulation - simulation|: {} kPa, {} mA over {} steps ({} steps used an off-schedule frame)\n",
+             format_double(r.vs_simulation.max_abs_diff_kPa), format_double(r.vs_simulation.max_abs_diff_mA),
+             r.vs_simulation.compared, r.off_schedule);
+  fmt::print("logs in {}/ (master.csv, master.events.csv, master_bus.log, slave.csv, *.json, report.json)\n", r.out_dir);
+}
+
+int run_run(const RunOptions& o) {
+  hil::SessionOptions so;
+  so.settings = load_settings(o.common);
+  if (o.seed >= 0) so.settings.plant.seed = static_cast<std::uint64_t>(o.seed);
+  so.config = settings_path(o.common);
+  so.loop = loop_options(o.common, so.settings);
+  so.slave_cpu = o.slave_cpu;
+  so.duration_s = o.duration;
+  so.reference = o.reference;
+  so.out_dir = o.out_dir;
+  so.isolate = !o.no_isolate;
+  so.restart_slave = o.restart_slave;
+  so.validate();
+  hil::install_session_signal_handlers();
+  hil::Session session(so);
+  const hil::RunReport r =
+      session.run([](const std::string& line) { fmt::print(stderr, "lash hil run: {}\n", line); });
+  if (o.json_out) {
+    std::fputs(hil::run_report_json(r).c_str(), stdout);
+  } else {
+    print_report(r);
+  }
+  if (r.interrupted) return 128 + r.interrupt_signal;
+  bool ok = r.have_master && r.master_exit.status == 0;
+  for (const auto& e : r.slave_exits) ok = ok && e.status == 0;
+  for (const auto& g : r.restarts) ok = ok && g.restarted_s >= 0;
+  if (!ok) fmt::print(stderr, "lash hil run: a node failed (see {}/report.json)\n", o.out_dir);
+  return ok ? kExitOk : kExitFailed;
+}
+
+int run_simulate(const SimulateOptions& o) {
+  CommonOptions co;
+  co.config = o.config;
+  co.step_ms = o.step_ms;
+  hil::BenchSettings s = load_settings(co);
+  if (o.seed >= 0) s.plant.seed = static_cast<std::uint64_t>(o.seed);
+  const hil::BenchLayout L = hil::BenchLayout::from_dbc(s.dbc_file);
+  const hil::SlaveConfig sc = hil::slave_config(s, L);
+  const hil::MasterConfig mc = hil::master_config(s, o.reference);
+  const std::size_t N = hil::steps_for(o.duration, s.step_s, "--duration");
+  const hil::SimulationResult sim = hil::simulate_bench(L, mc, sc, N);
+  std::vector<double> c_m, c_t, c_r, c_y, c_i, c_p;
+  for (std::size_t m = 0; m < N; ++m) {
+    const auto& ml = sim.master[m + 1];
+    c_m.push_back(static_cast<double>(ml.control_step));
+    c_t.push_back(static_cast<double>(m) * s.step_s);
+    c_r.push_back(ml.reference_kPa);
+    c_y.push_back(ml.measured_kPa);
+    c_i.push_back(ml.current_mA);
+    c_p.push_back(sim.slave[m].pressure_kPa);
+  }
+  write_columns_csv(o.out, {"control_step", "t_s", "reference_kPa", "measured_kPa", "current_mA", "pressure_kPa"},
+                    {&c_m, &c_t, &c_r, &c_y, &c_i, &c_p});
+  fmt::print(stderr, "lash hil simulate: {} steps at {} ms -> {}\n", N, format_double(s.step_s * 1e3), o.out);
+  if (const auto sr = hil::step_response(c_r, s.step_s, c_p))
+    fmt::print("step {} -> {} kPa at t = {} s: 90% rise {:.4f} s, 10% settling {:.4f} s, overshoot {:.1f} %\n",
+               format_double(sr->window.y0), format_double(sr->window.y1), format_double(sr->window.t_step_s),
+               sr->plant.rise_s, sr->plant.settling_s, sr->plant.overshoot_pct);
+  return kExitOk;
+}
+
+}  // namespace
+
+void add_hil_run(CLI::App* hil, std::function<int()>& run_selected) {
+  auto ro = std::make_shared<RunOptions>();
+  auto* run = hil->add_subcommand("run", "Slave and master as two processes on a private UDP bus; report");
+  add_common(run, ro->common);
+  add_duration(run, ro->duration, "Control time");
+  run->add_option("--reference", ro->reference, "Reference (see `lash hil master --help`)");
+  run->add_option("--out-dir", ro->out_dir, "Where the logs go (the files of a run are replaced, never mixed)");
+  run->add_option("--seed", ro->seed, "Noise seed of the plant (-1 = from the settings)")
+      ->check(CLI::Range(std::int64_t{-1}, INT64_MAX));
+  run->add_flag("--json", ro->json_out, "Print the report as one JSON object");
+  run->add_flag("--no-isolate", ro->no_isolate, "Use the host's network instead of a private namespace");
+  run->add_flag("--restart-slave", ro->restart_slave, "Watchdog: start a slave that died again (the report shows the gap)");
+  run->add_option("--slave-cpu", ro->slave_cpu, "Pin the slave to this CPU (-1 = as --cpu, which pins the master)")
+      ->check(CLI::Range(-1, 4095));
+
+  auto sio = std::make_shared<SimulateOptions>();
+  auto* sim = hil->add_subcommand("simulate", "Closed-loop simulation through the nodes' step functions");
+  sim->option_defaults()->always_capture_default();
+  sim->add_option("--config", sio->config, "Node settings (TOML)");
+  sim->add_option("--step-ms", sio->step_ms,
+                  "Fixed step [ms], " + format_double(hil::kMinStepMs) + ".." + format_double(hil::kMaxStepMs) +
+                      " (0 = from the settings)")
+      ->check(CLI::Range(0.0, hil::kMaxStepMs));
+  add_duration(sim, sio->duration, "Control time");
+  sim->add_option("--reference", sio->reference, "Reference (see `lash hil master --help`)");
+  sim->add_option("--seed", sio->seed, "Noise seed of the plant (-1 = from the settings)")
+      ->check(CLI::Range(std::int64_t{-1}, INT64_MAX));
+  sim->add_option("-o,--output", sio->out, "Output CSV");
+
+  run_selected = [=]() -> int {
+    if (run->parsed()) return run_run(*ro);
+    if (sim->parsed()) return run_simulate(*sio);
+    return -1;
+  };
+}
+
+}  // namespace lash::cli::hilcli

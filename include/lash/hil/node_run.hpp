@@ -1,0 +1,153 @@
+#pragma once
+/// @file node_run.hpp
+/// One node of the bench as a process runs it (`lash hil slave`, `lash hil master`, and the
+/// children of `lash hil run`): settings → node → emulated CAN controller on a bus → the
+/// periodic loop, and what a run leaves behind (logs, loop records, counters) in memory.
+/// The option checks live here too, so that every face of the library refuses the same
+/// values with the same message before any work. Not real-time code, except the loops it runs.
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "lash/can/controller_bus.hpp"
+#include "lash/hil/nodes.hpp"
+#include "lash/hil/settings.hpp"
+#include "lash/rt/periodic.hpp"
+
+namespace lash::hil {
+
+/// Limits of the real-time options (documented in `--help`).
+inline constexpr double kMinStepMs = 0.1;     ///< shortest step the loop is let run [ms] (see docs/hil.md)
+inline constexpr double kMaxStepMs = 1000.0;  ///< longest step [ms]
+/// Most steps one run may record: 2e7 steps × (32 B loop record + < 64 B node log) < 2 GB.
+inline constexpr std::size_t kMaxSteps = 20'000'000;
+
+/// Real-time options shared by the nodes and `lash hil latency`.
+struct LoopOptions {
+  double step_s = 0.005;                       ///< T [s]
+  int fifo = 0;                                ///< SCHED_FIFO priority 1–99; 0 = default scheduler
+  int cpu = -1;                                ///< pin to this CPU; −1 = no pinning
+  double spin_us = 0.0;                        ///< busy-wait this long before each release [µs]
+  bool lock_memory = false;                    ///< mlockall()
+  rt::OverrunPolicy policy = rt::OverrunPolicy::tolerate;
+  std::size_t max_overruns = 10;               ///< policy stop: consecutive overruns before stopping
+  bool hold_dma_latency = true;                ///< hold /dev/cpu_dma_latency at 0 µs while the loop runs
+  /// Throws InputError naming the option (`--fifo`, `--step-ms`, …) for a value out of its range.
+  void validate() const;
+};
+
+/// Parses `tolerate` / `stop`; throws InputError(field `--overrun-policy`) otherwise.
+rt::OverrunPolicy parse_overrun_policy(const std::string& text);
+/// Steps of a run of `duration_s` at `step_s`: ≥ 1, and refused (InputError naming `option`)
+/// when not finite, ≤ 0 or above kMaxSteps.
+std::size_t steps_for(double duration_s, double step_s, const std::string& option);
+/// The loop configuration of `steps` steps (options validated first).
+rt::LoopConfig make_loop_config(const LoopOptions& o, std::size_t steps);
+
+/// The nodes' CAN controller: reception may take a fifth of the step, however hard the bus
+/// is flooded (a babbling node); what is left waits on the wire for the next step.
+can::ControllerConfig node_controller_config(std::int64_t period_ns);
+/// Opens the node's bus with its acceptance filters (master: sensors + DTO; slave: command + CRO).
+std::unique_ptr<can::Bus> open_node_bus(const std::string& address, const BenchLayout& layout, bool master);
+
+/// Built once from the settings (the simulation and the slave node share it).
+SlaveConfig slave_config(const BenchSettings& s, const BenchLayout& layout, std::size_t log_capacity = 0);
+/// reference: `KIND:key=value,…` (parse_reference); dto_timeout_s ≤ 0 → the settings' value.
+MasterConfig master_config(const BenchSettings& s, const std::string& reference, double dto_timeout_s = 0.0,
+                           std::size_t log_capacity = 0);
+
+/// Frame counters of one node at the end of its run.
+struct FrameStats {
+  std::uint64_t sent = 0, received = 0, late = 0, lost = 0, duplicates = 0, resyncs = 0, ignored = 0,
+                send_failures = 0, bus_filtered = 0, bus_dropped = 0, bus_log_dropped = 0;
+};
+
+/// What a node's run ends with, apart from its per-step logs (trivially copyable).
+struct NodeStats {
+  rt::RunResult result;
+  std::int64_t period_ns = 0;
+  double epoch_s = 0.0;          ///< CLOCK_REALTIME of the loop's r_0 [s]
+  FrameStats frames;
+  can::ControllerStats controller;
+  bool dma_latency_held = false; ///< /dev/cpu_dma_latency was held at 0 during the loop
+  // master only
+  MasterState state = MasterState::connecting;
+  std::int64_t control_steps = 0;
+  double handshake_s = -1.0;
+  // slave only
+  bool connected = false;
+  std::uint64_t dto_replies = 0;
+  std::uint64_t seed = 0;
+};
+
+/// The loop's side of a run: per-step records and overruns, settings warnings.
+struct LoopTrace {
+  std::vector<rt::StepRecord> records;
+  std::vector<rt::OverrunEvent> overruns;
+  std::vector<std::string> warnings;
+};
+
+struct SlaveRun {
+  NodeStats stats;
+  LoopTrace loop;
+  std::vector<SlaveStepLog> log;
+};
+
+struct MasterRun {
+  NodeStats stats;
+  LoopTrace loop;
+  std::vector<MasterStepLog> log;
+  std::vector<MasterEvent> events;
+  std::vector<LoggedFrame> bus_log;  ///< timestamps as the node saw them (see write_bus_log)
+};
+
+struct SlaveRunOptions {
+  LoopOptions loop;
+  double duration_s = 600.0;        ///< longest run (log size) [s]
+  double connect_timeout_s = 0.0;   ///< 0 = wait for CONNECT until stopped
+};
+
+struct MasterRunOptions {
+  LoopOptions loop;
+  double duration_s = 10.0;         ///< control time after the handshake [s]
+  std::string reference = "step:from=500,to=1500,time=1";
+  double dto_timeout_s = 0.0;       ///< 0 = from the settings
+};
+
+/// Runs the slave: waits for a CCP CONNECT (polling `stop`), then steps until `stop`, the
+/// duration or an overrun stop. `on_ready(address)` is called once the bus is open.
+SlaveRun run_slave_node(const BenchSettings& s, const SlaveRunOptions& o, const std::atomic<bool>& stop,
+                        const std::function<void(const std::string&)>& on_ready = {});
+/// Runs the master: CONNECT, then `duration_s` of control (or until `stop`).
+MasterRun run_master_node(const BenchSettings& s, const MasterRunOptions& o, const std::atomic<bool>& stop);
+
+/// The flag a node's loop stops on, and handlers for SIGINT, SIGTERM and SIGHUP that set it
+/// (no SA_RESTART: sleeps and blocking receives return at once). Not real-time safe.
+const std::atomic<bool>& node_stop_flag() noexcept;
+void install_node_signal_handlers();
+
+/// Log files of a run (atomic writes; columns documented in docs/hil.md).
+void write_slave_csv(const std::filesystem::path& path, const SlaveRun& r);
+void write_master_csv(const std::filesystem::path& path, const MasterRun& r);
+void write_master_events(const std::filesystem::path& path, const MasterRun& r);
+/// candump -L log of the frames the master sent and received, in wall-clock seconds: a sent
+/// frame carries its loop time (added to the loop's epoch), a received one the bus's receive
+/// timestamp, which is wall-clock already.
+void write_bus_log(const std::filesystem::path& path, const MasterRun& r);
+/// The statistics JSON of `lash hil slave/master --stats`.
+std::string slave_stats_json(const SlaveRun& r);
+std::string master_stats_json(const MasterRun& r, const std::string& reference);
+
+/// Binary hand-over of a run from a node process to its session (same executable on both
+/// sides): write at the end of the run to an inherited descriptor, read back after it exited.
+/// read_* returns false when the node wrote nothing (it was killed) or the data are cut short.
+void write_run(int fd, const SlaveRun& r);
+void write_run(int fd, const MasterRun& r);
+bool read_run(int fd, SlaveRun& r);
+bool read_run(int fd, MasterRun& r);
+
+}  // namespace lash::hil
