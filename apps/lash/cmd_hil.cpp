@@ -10,6 +10,8 @@
 #include <cmath>
 #include <filesystem>
 
+#include <fmt/core.h>
+
 #include "lash/io/csv.hpp"
 
 namespace lash::cli::hilcli {
@@ -51,6 +53,7 @@ std::string settings_path(const CommonOptions& o) {
 
 hil::BenchSettings load_settings(const CommonOptions& o) {
   hil::BenchSettings s = hil::load_bench_settings(settings_path(o));
+  for (const auto& w : s.warnings) fmt::print(stderr, "lash: warning: {}\n", w);
   if (!o.bus.empty()) s.bus = o.bus;
   if (o.step_ms != 0.0) {
     if (!(o.step_ms >= hil::kMinStepMs) || !std::isfinite(o.step_ms))

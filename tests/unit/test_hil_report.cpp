@@ -176,3 +176,31 @@ TEST(HilRunReport, HandOverRoundTrip) {
   close(fd);
   close(empty);
 }
+
+#include <fstream>
+
+TEST(HilSettings, InlineControllerHasTheGainsFileSchemaFlatKeysDeprecated) {
+  const std::string src = LASH_SOURCE_DIR;
+  const std::string dir = ::testing::TempDir();
+  const std::string head = "dbc = \"" + src + "/config/hydraulic_bench.dbc\"\ndto_log = \"" + src +
+                           "/config/hil/ccp_connect.log\"\n";
+  std::ofstream(dir + "/nested.toml") << head
+                                      << "[controller.pid]\nkp = 2\nki_per_s = 30\nkd_s = 0.5\n"
+                                         "[controller.deadzone_inverse]\noffset_mA = 250\n"
+                                         "[controller.saturation]\nmax_mA = 1800\n";
+  std::ofstream(dir + "/flat.toml") << head
+                                    << "[controller]\nkp = 2\nki_per_s = 30\nkd_s = 0.5\ndeadzone_inverse_mA = 250\n"
+                                       "current_max_mA = 1800\n";
+  const BenchSettings a = load_bench_settings(dir + "/nested.toml");
+  const BenchSettings b = load_bench_settings(dir + "/flat.toml");
+  EXPECT_TRUE(a.warnings.empty());
+  EXPECT_EQ(b.warnings.size(), 5u);
+  for (const BenchSettings* s : {&a, &b}) {
+    EXPECT_EQ(s->controller.pid.gains.kp, 2.0);
+    EXPECT_EQ(s->controller.pid.gains.ki_per_s, 30.0);
+    EXPECT_EQ(s->controller.pid.gains.kd_s, 0.5);
+    EXPECT_EQ(s->controller.dz_inverse.offset_left, 250.0);
+    EXPECT_EQ(s->controller.current_max_mA, 1800.0);
+    EXPECT_EQ(s->controller.pid.dt_s, 0.005);  // the bench's step
+  }
+}
