@@ -119,30 +119,4 @@ EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> 
   return run;
 }
 
-double nrmse(std::span<const double> t, std::span<const double> y, std::span<const double> ysim, double t0_s,
-             double t1_s) {
-  double se = 0.0, ymax = 0.0;
-  std::size_t n = 0;
-  for (std::size_t k = 0; k < t.size(); ++k) {
-    if (t[k] < t0_s || t[k] > t1_s) continue;
-    const double e = y[k] - ysim[k];
-    se += e * e;
-    ymax = std::max(ymax, std::fabs(y[k]));
-    ++n;
-  }
-  if (n == 0 || ymax == 0.0) return std::numeric_limits<double>::quiet_NaN();
-  return std::sqrt(se / static_cast<double>(n)) / ymax;
-}
-
-double outside_3sigma_per_1000(std::span<const double> t, std::span<const double> y, std::span<const double> yhat,
-                               double sigma, double t0_s, double t1_s) {
-  std::size_t n = 0, out = 0;
-  for (std::size_t k = 0; k < t.size(); ++k) {
-    if (t[k] < t0_s || t[k] > t1_s) continue;
-    ++n;
-    if (!(std::fabs(y[k] - yhat[k]) <= 3.0 * sigma)) ++out;
-  }
-  return n == 0 ? std::numeric_limits<double>::quiet_NaN() : 1000.0 * static_cast<double>(out) / static_cast<double>(n);
-}
-
 }  // namespace lash

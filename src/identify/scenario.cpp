@@ -136,9 +136,4 @@ ScenarioRun run_scenario(const ScenarioSpec& s, std::uint64_t seed) {
   return run;
 }
 
-double error_percent(double estimate, double truth) noexcept {
-  if (!std::isfinite(estimate)) return std::numeric_limits<double>::quiet_NaN();
-  return 100.0 * std::fabs(estimate - truth) / std::fabs(truth);
-}
-
 }  // namespace lash

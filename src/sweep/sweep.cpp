@@ -9,27 +9,22 @@
 #include <mutex>
 #include <thread>
 
+#include "lash/metrics/error.hpp"
+#include "lash/metrics/first_order.hpp"
+#include "lash/metrics/fit.hpp"
 #include "lash/plant/simulate.hpp"
 
 namespace lash::sweep {
 namespace {
 
-/// NRMSE accumulator over a window of sample indices [k0, k1].
+/// NRMSE over a window of sample indices [k0, k1].
 struct Score {
   std::size_t k0 = 0, k1 = 0;
-  double sum_sq = 0.0, max_abs = 0.0;
-  std::size_t n = 0;
+  NrmseAccumulator acc;
   void add(std::size_t k, double y, double ysim) noexcept {
-    if (k < k0 || k > k1) return;
-    const double e = y - ysim;
-    sum_sq += std::isfinite(e) ? e * e : std::numeric_limits<double>::infinity();
-    max_abs = std::max(max_abs, std::fabs(y));
-    ++n;
+    if (k >= k0 && k <= k1) acc.add(y, ysim);
   }
-  double nrmse() const noexcept {
-    if (n == 0 || max_abs == 0.0) return kNaN;
-    return std::sqrt(sum_sq / static_cast<double>(n)) / max_abs;
-  }
+  double nrmse() const noexcept { return acc.value(); }
 };
 
 /// Range of v(k−1) over the samples on which each side's RLS updated (excitation check).
@@ -73,8 +68,8 @@ void fill_sides(RunResult& out, const Est& est, const Excitation& ex, double dt_
     r.c = p.c;
     r.identified = p.identified && std::isfinite(p.a1) && std::isfinite(p.b1) && std::isfinite(p.c);
     if (std::isfinite(p.a1) && std::isfinite(p.b1)) {
-      r.gain = p.b1 / (1.0 + p.a1);
-      r.tau_s = (p.a1 < 0.0 && p.a1 > -1.0) ? -dt_s / std::log(-p.a1) : kNaN;
+      r.gain = static_gain(p.a1, p.b1);
+      r.tau_s = time_constant_s(p.a1, dt_s);
     }
     if (r.identified && check_excitation && !ex.exciting(s)) {
       r.identified = false;
@@ -99,22 +94,17 @@ void fill_sides(RunResult& out, const Est& est, const Excitation& ex, double dt_
   }
 }
 
-double rel_err(double est, double truth) {
-  if (!std::isfinite(est) || !std::isfinite(truth) || truth == 0.0) return std::numeric_limits<double>::infinity();
-  return std::fabs(est / truth - 1.0);
-}
-
 void score_params(RunResult& out, bool compare_tau) {
   double worst = -1.0;
   for (Side s : {Side::right, Side::left}) {
     const SideResult& r = out.side[s];
     if (!r.identified) continue;
     const auto& t = out.truth.side[s];
-    worst = std::max(worst, rel_err(r.gain, t.gain));
-    worst = std::max(worst, rel_err(r.c, t.c));
-    if (compare_tau) worst = std::max(worst, rel_err(r.tau_s, t.tau_s));
+    worst = std::max(worst, relative_error(r.gain, t.gain));
+    worst = std::max(worst, relative_error(r.c, t.c));
+    if (compare_tau) worst = std::max(worst, relative_error(r.tau_s, t.tau_s));
   }
-  if (out.d_identified) worst = std::max(worst, rel_err(out.d, out.truth.d));
+  if (out.d_identified) worst = std::max(worst, relative_error(out.d, out.truth.d));
   out.param_error = worst < 0.0 ? kNaN : worst;
 }
 
@@ -152,7 +142,7 @@ RunResult finish(const Campaign& c, const RunSpec& r, const Est& est, const Scor
   RunResult out;
   out.spec = r;
   out.nrmse = score.nrmse();
-  out.max_abs_y = score.max_abs;
+  out.max_abs_y = score.acc.max_abs;
   fill_sides(out, est, ex, c.dt_s, check_excitation);
   return out;
 }

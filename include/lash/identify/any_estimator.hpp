@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "lash/identify/estimators.hpp"
+#include "lash/metrics/fit.hpp"  // nrmse, outside_3sigma_per_1000 (were declared here)
 
 namespace lash {
 
@@ -84,12 +85,5 @@ struct EstimationRun {
 /// Steps `cfg`'s estimator through v, y (same length). keep_trace stores the parameters per step.
 EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> v, std::span<const double> y,
                             bool keep_trace = false);
-
-/// NRMSE = RMS(y − y_sim) / max|y| over t ∈ [t0, t1] (SPEC A6); NaN if the window is empty.
-double nrmse(std::span<const double> t, std::span<const double> y, std::span<const double> ysim, double t0_s,
-             double t1_s);
-/// Count per 1000 samples of |y − ŷ| > 3σ over t ∈ [t0, t1] (SPEC A6).
-double outside_3sigma_per_1000(std::span<const double> t, std::span<const double> y, std::span<const double> yhat,
-                               double sigma, double t0_s, double t1_s);
 
 }  // namespace lash
