@@ -20,6 +20,7 @@ SideParams read_truth(TomlTable t) {
   p.c = t.number_or("c", p.c);
   p.d = t.number_or("d", p.d);
   p.identified = true;
+  p.reason = Reason::none;
   t.finish();
   return p;
 }

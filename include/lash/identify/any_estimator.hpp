@@ -16,7 +16,9 @@ namespace lash {
 
 /// Summary of one side (or of the whole model for `linear`, kept in `right`).
 struct SideReport {
-  SideParams params;  ///< NaN = not identified (JSON null)
+  SideParams params;  ///< NaN = not identified (JSON null); params.identified/reason: the full verdict
+  double K = std::numeric_limits<double>::quiet_NaN();      ///< static gain b1/(1 + a1) [y unit / v unit]
+  double tau_s = std::numeric_limits<double>::quiet_NaN();  ///< time constant −T/ln(−a1) [s]
   std::vector<std::pair<std::string, std::uint64_t>> updates;  ///< per key: "+"/"-" or "all"
 };
 
@@ -31,6 +33,8 @@ struct EstimateReport {
   bool has_shared_d = false;   ///< coupled-carts: one d for both directions
   SideReport right, left;      ///< linear: only `right` is meaningful
   double d = std::numeric_limits<double>::quiet_NaN();  ///< coupled-carts
+  Reason d_reason = Reason::not_updated;                ///< coupled-carts: verdict of d
+  double fit_nrmse = std::numeric_limits<double>::quiet_NaN();  ///< the verdict's free-run NRMSE (fraction)
   std::vector<std::pair<std::string, std::uint64_t>> d_updates;
 };
 
@@ -53,8 +57,23 @@ class AnyEstimator {
   bool identified() const noexcept {
     return std::visit([](const auto& e) noexcept { return e.identified(); }, e_);
   }
-  /// Per-side parameters (linear: both sides return the single model).
-  SideParams params(Side s) const noexcept;
+  /// Per-side parameters with the update-time verdict (linear: both sides return the single model).
+  SideParams params(Side s) const noexcept {
+    return std::visit([s](const auto& e) noexcept { return e.params(s); }, e_);
+  }
+  /// The full verdict of a side (verdict.hpp); Reason::none = identified.
+  Reason verdict(Side s) const noexcept {
+    return std::visit([s](const auto& e) noexcept { return e.verdict(s); }, e_);
+  }
+  std::uint64_t skipped() const noexcept {
+    return std::visit([](const auto& e) noexcept { return e.skipped(); }, e_);
+  }
+  std::uint64_t samples() const noexcept { return samples_; }
+  /// Back to the state right after construction. Not real-time safe.
+  void reset() {
+    std::visit([](auto& e) { e.reset(); }, e_);
+    samples_ = 0;
+  }
 
   /// Names of the per-step parameter columns ("a1_r", "b1_r", "c_r", "d_r", …).
   std::vector<std::string> param_names() const;
