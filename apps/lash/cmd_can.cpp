@@ -87,8 +87,7 @@ int run_dump(const DumpOptions& o) {
   auto bus = can::open_bus(o.bus);
   if (!filters.empty()) bus->set_filters(filters);
   const std::string iface = o.iface.empty() ? default_iface(o.bus) : o.iface;
-  std::unique_ptr<AtomicFile> log;
-  if (!o.log.empty()) log = std::make_unique<AtomicFile>(o.log);
+  std::vector<can::LogEntry> logged;
   install_stop_handler();
   long n = 0;
   timespec start{};
@@ -111,10 +110,10 @@ int run_dump(const DumpOptions& o) {
       std::fputc('\n', stdout);
       std::fflush(stdout);
     }
-    if (log) log->stream() << line << '\n';
+    if (!o.log.empty()) logged.push_back({*f, iface});
     ++n;
   }
-  if (log) log->commit();
+  if (!o.log.empty()) can::write_log(o.log, logged);
   const auto st = bus->stats();
   fmt::print(stderr, "lash can dump: {} frames ({} filtered, {} dropped)\n", n, st.filtered, st.dropped);
   if (o.count >= 0 && n < o.count) return kExitFailed;
@@ -155,7 +154,7 @@ std::vector<Sub> add_bus_commands(CLI::App& sub) {
       ->check(CLI::Range(1L, 1000000000000L));
   d->add_option("--timeout", dump->timeout_s, "Stop after this many seconds [s], 0 < T <= 1e6 (default: run until a signal)")
       ->check(CLI::Range(1e-6, 1e6));
-  d->add_option("--log", dump->log, "Also write the frames as a candump -L log (written on exit)");
+  d->add_option("--log", dump->log, "Also write the frames to this log on exit; format by extension: .asc, .blf, .trc, else candump -L");
   d->add_option("--iface", dump->iface, "Interface name written in the lines (default: the socketcan name or can0)");
   d->add_flag("--quiet", dump->quiet, "Do not print frames to stdout");
   d->add_option("--filter", dump->filters, "Accept only ID:MASK (hex; 8-digit id = 29-bit); repeatable");

@@ -57,7 +57,7 @@ struct DecodeOptions {
 
 int run_decode(const DecodeOptions& o) {
   const auto db = load(o.dbc, o.strict, false);
-  const auto entries = can::read_log(o.log);
+  const auto entries = read_log_reporting(o.log, "decode");
   std::map<std::pair<std::uint32_t, bool>, std::unique_ptr<can::MessageCodec>> codecs;
   std::map<std::pair<std::uint32_t, bool>, std::string> broken;  // messages whose layout has errors
   std::vector<double> values;
@@ -117,10 +117,10 @@ std::vector<Sub> add_codec_commands(CLI::App& sub) {
                 "SIGNAL=VALUE: physical units, an exact raw integer (factor 1, offset 0) or a VAL_ text; "
                 "unset signals take GenSigStartValue, else raw 0");
   auto dec = std::make_shared<DecodeOptions>();
-  auto* c = sub.add_subcommand("decode", "Decode a candump -L log with a DBC: time message signal=value unit ...");
+  auto* c = sub.add_subcommand("decode", "Decode a log (.asc, .blf, .trc, candump) with a DBC: time message signal=value unit ...");
   c->add_option("--dbc", dec->dbc, "DBC file")->required();
   c->add_flag("--strict", dec->strict, "Refuse a DBC with any reader warning");
-  c->add_option("log", dec->log, "candump -L log file")->required();
+  c->add_option("log", dec->log, "Log file: .asc, .blf, .trc or candump")->required();
   return {{e, [=] { return run_encode(*enc); }}, {c, [=] { return run_decode(*dec); }}};
 }
 

@@ -349,7 +349,8 @@ std::string format_log_line(const Frame& frame, std::string_view interface) {
     sec += 1;
     us -= 1000000;
   }
-  return fmt::format("({}.{:06d}) {} {}", sec, us, interface, format_frame_text(frame));
+  return fmt::format("({}.{:06d}) {} {}", sec, us, interface.empty() ? std::string_view("can0") : interface,
+                     format_frame_text(frame));
 }
 
 std::vector<LogEntry> parse_log(std::string_view text, const std::string& file, LogReadReport* report) {

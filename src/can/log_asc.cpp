@@ -110,7 +110,9 @@ std::string parse_frame_line(const std::string_view* p, std::size_t n, int base,
     std::uint32_t dlc = 0, len = 0;
     if (!to_uint(p[k + 2], base, dlc) || dlc > 15) return "bad DLC '" + std::string(p[k + 2]) + "'";
     if (!to_uint(p[k + 3], 10, len) || len > 64) return "bad data length '" + std::string(p[k + 3]) + "'";
-    if (len == 0 && dlc != 0) {  // python-can: a remote frame
+    if (len == 0 && dlc != 0) {
+      // python-can reads this as a remote frame; CAN FD has no remote frames, so it is a
+      // classic remote frame logged on an FD channel.
       f.remote = true;
       f.fd = false;
       f.brs = f.esi = false;
@@ -133,14 +135,16 @@ std::string parse_frame_line(const std::string_view* p, std::size_t n, int base,
   std::uint32_t dlc = 0;
   if (p[4] == "r" || p[4] == "R") {
     f.remote = true;
-    if (n > 5 && !to_uint(p[5], base, dlc)) return "bad DLC '" + std::string(p[5]) + "'";
-    if (dlc > 8) return fmt::format("remote frame DLC {} > 8", dlc);
+    // an optional DLC; "Length = …" and other trailing fields are not one (as python-can)
+    if (n > 5 && !to_uint(p[5], base, dlc)) dlc = 0;
+    if (dlc > 8) dlc = 8;  // DLC 9–15 of a classic frame means 8 bytes
     f.len = static_cast<std::uint8_t>(dlc);
     return "";
   }
   if (p[4] != "d" && p[4] != "D") return "expected 'd' or 'r', found '" + std::string(p[4]) + "'";
-  if (n < 6 || !to_uint(p[5], base, dlc) || dlc > 15) return "bad DLC";
-  const std::uint32_t len = std::min<std::uint32_t>(8, dlc_to_len(dlc));
+  if (n < 6 || !to_uint(p[5], base, dlc)) return "bad DLC";
+  if (dlc > 15) return fmt::format("classic frame DLC {} (0x{:X}) is more than 4 bits", dlc, dlc);
+  const std::uint32_t len = std::min<std::uint32_t>(8, dlc);  // DLC 9–15 of a classic frame means 8 bytes
   f.len = static_cast<std::uint8_t>(len);
   return bytes(6, len);
 }

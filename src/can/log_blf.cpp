@@ -174,8 +174,8 @@ void parse_objects(std::string_view d, double start, const std::string& file, Lo
       const auto flags = get<std::uint8_t>(d, p + 2);
       const auto dlc = get<std::uint8_t>(d, p + 3);
       id = get<std::uint32_t>(d, p + 4);
-      const auto fdf = get<std::uint8_t>(d, p + 14);
-      const auto valid = get<std::uint8_t>(d, p + 15);
+      const auto fdf = get<std::uint8_t>(d, p + 13);
+      const auto valid = get<std::uint8_t>(d, p + 14);
       f.remote = (flags & 0x80) != 0;
       f.fd = (fdf & 1) != 0;
       f.brs = (fdf & 2) != 0;

@@ -83,6 +83,7 @@ std::string set_data(Frame& f, const std::string_view* p, std::size_t from, std:
 std::string parse_line(const Layout& lay, const std::string_view* p, std::size_t n, LogEntry& e, bool& skip) {
   Frame& f = e.frame;
   skip = false;
+  e.interface = "1";  // versions without a bus column: channel 1 (as python-can)
   double ms = 0;
   std::uint32_t len = 0;
   if (lay.version < 200) {  // "N)" first
@@ -116,6 +117,12 @@ std::string parse_line(const Layout& lay, const std::string_view* p, std::size_t
       ++k;
     }
     if (!dec(p[k], len)) return "bad DLC '" + std::string(p[k]) + "'";
+    if (n > k + 1 && p[k + 1] == "RTR") {  // remote frame: "N) time [type] id dlc RTR"
+      f.remote = true;
+      if (len > 8) return fmt::format("remote frame DLC {} > 8", len);
+      f.len = static_cast<std::uint8_t>(len);
+      return "";
+    }
     return set_data(f, p, k + 1, n, len);
   }
   // 2.x: by columns
