@@ -93,12 +93,19 @@ $L can dump --bus mem:x --count 0 --timeout 1 2>/dev/null; r3=$?
 $L can replay --bus mem:x --speed 0 "$tmp/big.log" 2>/dev/null; r4=$?
 set -e
 expect "$r1 $r2 $r3 $r4" "2 2 2 2"
-printf '(1.000000) can0 100#00\n(2.000000) can0 100#0\n' > "$tmp/bad.log"
+# A bad log line is a counted, reported drop (file and line), the rest is decoded.
+printf '(1.000000) can0 100#00\n(2.000000) can0 100#0\n(3.000000) can0 7AB#00\n' > "$tmp/bad.log"
+$L can decode --dbc "$DBC" "$tmp/bad.log" > "$tmp/dec.txt" 2>"$tmp/err"
+expect "$(wc -l < "$tmp/dec.txt")" 2
+grep -q "dropped: .*bad.log:2: bad hex data" "$tmp/err" || fail "log drop: $(cat "$tmp/err")"
+grep -q "1 of 3 records of .*bad.log dropped" "$tmp/err" || fail "log drop count: $(cat "$tmp/err")"
+# A file that is no log at all: exit 2.
+printf 'not a blf' > "$tmp/x.blf"
 set +e
-$L can decode --dbc "$DBC" "$tmp/bad.log" > /dev/null 2>"$tmp/err"; rc=$?
+$L can decode --dbc "$DBC" "$tmp/x.blf" > /dev/null 2>"$tmp/err"; rc=$?
 set -e
 expect "$rc" 2
-grep -q "bad.log:2" "$tmp/err" || fail "log error: $(cat "$tmp/err")"
+grep -q "x.blf.*not a BLF file" "$tmp/err" || fail "blf error: $(cat "$tmp/err")"
 set +e
 $L can send --bus mem:x 123#GG 2>"$tmp/err"; rc1=$?
 $L can dump --bus nope:x --log "$tmp/never.log" 2>/dev/null; rc2=$?
