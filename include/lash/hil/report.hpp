@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "lash/control/step_metrics.hpp"
+#include "lash/metrics/step_response.hpp"
 #include "lash/hil/node_run.hpp"
 #include "lash/hil/nodes.hpp"
 #include "lash/rt/periodic.hpp"
