@@ -38,6 +38,15 @@ struct Reader {
   }
 };
 
+// An E2E CRC signal: one whole byte (8 bits, Intel, byte-aligned) inside the frame.
+BitField crc_field(const Reader& r, const can::dbc::Message& m, const char* name) {
+  BitField f = r.field(m, name, 8, 8);
+  const auto& s = f.signal();
+  if (s.byte_order != can::dbc::ByteOrder::intel || s.start_bit % 8 != 0 || s.start_bit / 8 >= m.size)
+    throw InputError(r.file, 0, m.name + "." + name, "an E2E CRC must be one whole byte of the frame (start bit a multiple of 8, Intel)");
+  return f;
+}
+
 std::uint8_t len_of(const can::dbc::Message& m, const std::string& file) {
   if (m.size > 8) throw InputError(file, 0, m.name, "classic CAN frames carry at most 8 bytes");
   return static_cast<std::uint8_t>(m.size);
@@ -63,10 +72,12 @@ BenchLayout BenchLayout::from_dbc(const std::filesystem::path& dbc_file) {
   L.solenoid_a = r.field(cmd, "SolenoidA_Current");
   L.solenoid_b = r.field(cmd, "SolenoidB_Current");
   L.restrictor = r.field(cmd, "RestrictorValve_Cmd");
-  L.command_counter = r.field(cmd, "Command_Counter", 16, 16);
+  L.command_counter = r.field(cmd, "Command_Counter", 4, 16);
+  L.command_crc = crc_field(r, cmd, "Command_CRC");
   L.pilot = r.field(sen, "PilotPressure_Duty", 16, 16);
   L.supply = r.field(sen, "SupplyPressure_Duty", 16, 16);
   L.sensor_counter = r.field(sen, "Sensor_Counter", 16, 16);
+  L.sensors_crc = crc_field(r, sen, "Sensor_CRC");
   L.cro_cmd = r.field(cro, "CRO_CMD", 8, 8);
   L.cro_ctr = r.field(cro, "CRO_CTR", 8, 8);
   L.dto_pid = r.field(dto, "DTO_PID", 8, 8);

@@ -1,5 +1,8 @@
 #include "lash/hil/bench_layout.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <utility>
 
 namespace lash::hil {
 
@@ -19,9 +22,46 @@ can::dbc::Signal make_signal(std::uint32_t start_bit, std::uint32_t length, doub
 }  // namespace
 
 BitField::BitField(std::uint32_t start_bit, std::uint32_t length, double factor, double lo, double hi, bool intel)
-    : codec_(make_signal(start_bit, length, factor, lo, hi, intel)) {}
+    : codec_(make_signal(start_bit, length, factor, lo, hi, intel)) {
+  set_raw_range();
+}
 
-BitField::BitField(const can::dbc::Signal& signal) : codec_(signal) {}
+BitField::BitField(const can::dbc::Signal& signal) : codec_(signal) { set_raw_range(); }
+
+// The raw codes whose physical value raw·factor + offset lies in [min, max] (a relative
+// tolerance of 1e-9 absorbs the DBC's decimal factors), for unsigned integer signals.
+void BitField::set_raw_range() noexcept {
+  const auto& s = codec_.signal();
+  const std::uint64_t top = s.length >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << s.length) - 1u;
+  raw_lo_ = 0;
+  raw_hi_ = top;
+  if ((s.minimum == 0.0 && s.maximum == 0.0) || s.is_signed || s.value_type != can::dbc::ValueType::integer ||
+      s.factor == 0.0)
+    return;
+  double a = (s.minimum - s.offset) / s.factor, b = (s.maximum - s.offset) / s.factor;
+  if (a > b) std::swap(a, b);
+  const double tol = 1e-9 * std::max({1.0, std::abs(a), std::abs(b)});
+  const double lo = std::ceil(a - tol), hi = std::floor(b + tol);
+  const double dtop = static_cast<double>(top);
+  if (hi < 0 || lo > dtop || lo > hi) {  // an empty range: nothing is plausible
+    raw_lo_ = 1;
+    raw_hi_ = 0;
+    return;
+  }
+  raw_lo_ = lo <= 0 ? 0 : static_cast<std::uint64_t>(lo);
+  raw_hi_ = hi >= dtop ? top : static_cast<std::uint64_t>(hi);
+}
+
+std::uint8_t BenchLayout::e2e_crc(const can::Frame& f, const BitField& crc) noexcept {
+  const std::size_t at = crc.signal().start_bit / 8;
+  std::uint8_t reg = Crc8SaeJ1850::kInit;
+  reg = Crc8SaeJ1850::update(reg, static_cast<std::uint8_t>(f.id & 0xFFu));
+  reg = Crc8SaeJ1850::update(reg, static_cast<std::uint8_t>((f.id >> 8) & 0xFFu));
+  const std::size_t n = f.len <= can::Frame::kMaxClassicLen ? f.len : can::Frame::kMaxClassicLen;
+  for (std::size_t i = 0; i < n; ++i)
+    if (i != at) reg = Crc8SaeJ1850::update(reg, f.data[i]);
+  return Crc8SaeJ1850::finish(reg);
+}
 
 can::Frame BenchLayout::pack_command(const CommandMsg& m) const noexcept {
   can::Frame f;
@@ -31,7 +71,24 @@ can::Frame BenchLayout::pack_command(const CommandMsg& m) const noexcept {
   solenoid_b.put(f, solenoid_b.to_raw(m.solenoid_b_mA));
   restrictor.put(f, restrictor.to_raw(m.restrictor_mA));
   command_counter.put(f, m.counter);
+  command_crc.put(f, e2e_crc(f, command_crc));
   return f;
+}
+
+std::optional<Drop> BenchLayout::check_command(const can::Frame& f) const noexcept {
+  if (f.remote || f.len != command_len) return Drop::dlc;
+  if (command_crc.get(f) != e2e_crc(f, command_crc)) return Drop::crc;
+  if (!solenoid_a.in_range(solenoid_a.get(f)) || !solenoid_b.in_range(solenoid_b.get(f)) ||
+      !restrictor.in_range(restrictor.get(f)))
+    return Drop::range;
+  return std::nullopt;
+}
+
+std::optional<Drop> BenchLayout::check_sensors(const can::Frame& f) const noexcept {
+  if (f.remote || f.len != sensors_len) return Drop::dlc;
+  if (sensors_crc.get(f) != e2e_crc(f, sensors_crc)) return Drop::crc;
+  if (!pilot.in_range(pilot.get(f)) || !supply.in_range(supply.get(f))) return Drop::range;
+  return std::nullopt;
 }
 
 CommandMsg BenchLayout::unpack_command(const can::Frame& f) const noexcept {
@@ -50,6 +107,7 @@ can::Frame BenchLayout::pack_sensors(const SensorMsg& m) const noexcept {
   pilot.put(f, m.pilot_raw);
   supply.put(f, m.supply_raw);
   sensor_counter.put(f, m.counter);
+  sensors_crc.put(f, e2e_crc(f, sensors_crc));
   return f;
 }
 
