@@ -54,7 +54,7 @@ const char* to_string(NodeEventKind k) noexcept {
     case NodeEventKind::ramp_done: return "ramp_done_safe_state";
     case NodeEventKind::sensor_timeout: return "sensor_timeout_safe_state";
     case NodeEventKind::input_recovered: return "input_recovered";
-    case NodeEventKind::input_resumed: return "sensor_resumed";
+    case NodeEventKind::input_resumed: return "input_resumed";
     case NodeEventKind::dto_timeout: return "dto_timeout";
   }
   return "?";

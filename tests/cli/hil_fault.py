@@ -51,9 +51,9 @@ with open(f"{out}/events.csv") as f:
 kinds = [e[2] for e in events]
 print(events)
 assert kinds[:2] == ["ccp_connect_sent", "ccp_connected"], kinds
-assert "sensor_timeout_safe_state" in kinds and "sensor_resumed" in kinds, kinds
+assert "sensor_timeout_safe_state" in kinds and "input_resumed" in kinds, kinds
 # The kill is the longest fault (a busy machine may add short ones: each is logged too).
-faults = [(int(e[0]), next(int(r[0]) for r in events[i:] if r[2] == "sensor_resumed"))
+faults = [(int(e[0]), next(int(r[0]) for r in events[i:] if r[2] == "input_resumed"))
           for i, e in enumerate(events) if e[2] == "sensor_timeout_safe_state"]
 fault_step, resume_step = max(faults, key=lambda f: f[1] - f[0])
 steps = [int(v) for v in m["step"]]
