@@ -33,6 +33,9 @@ BitField::BitField(const can::dbc::Signal& signal) : codec_(signal) { set_raw_ra
 void BitField::set_raw_range() noexcept {
   const auto& s = codec_.signal();
   const std::uint64_t top = s.length >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << s.length) - 1u;
+  intel_ = s.byte_order == can::dbc::ByteOrder::intel && s.start_bit + s.length <= 64;
+  shift_ = s.start_bit;
+  mask_ = top;
   raw_lo_ = 0;
   raw_hi_ = top;
   if ((s.minimum == 0.0 && s.maximum == 0.0) || s.is_signed || s.value_type != can::dbc::ValueType::integer ||
@@ -58,8 +61,9 @@ std::uint8_t BenchLayout::e2e_crc(const can::Frame& f, const BitField& crc) noex
   reg = Crc8SaeJ1850::update(reg, static_cast<std::uint8_t>(f.id & 0xFFu));
   reg = Crc8SaeJ1850::update(reg, static_cast<std::uint8_t>((f.id >> 8) & 0xFFu));
   const std::size_t n = f.len <= can::Frame::kMaxClassicLen ? f.len : can::Frame::kMaxClassicLen;
-  for (std::size_t i = 0; i < n; ++i)
-    if (i != at) reg = Crc8SaeJ1850::update(reg, f.data[i]);
+  const std::size_t head = at < n ? at : n;
+  for (std::size_t i = 0; i < head; ++i) reg = Crc8SaeJ1850::update(reg, f.data[i]);
+  for (std::size_t i = head + 1; i < n; ++i) reg = Crc8SaeJ1850::update(reg, f.data[i]);
   return Crc8SaeJ1850::finish(reg);
 }
 
@@ -77,17 +81,19 @@ can::Frame BenchLayout::pack_command(const CommandMsg& m) const noexcept {
 
 std::optional<Drop> BenchLayout::check_command(const can::Frame& f) const noexcept {
   if (f.remote || f.len != command_len) return Drop::dlc;
-  if (command_crc.get(f) != e2e_crc(f, command_crc)) return Drop::crc;
-  if (!solenoid_a.in_range(solenoid_a.get(f)) || !solenoid_b.in_range(solenoid_b.get(f)) ||
-      !restrictor.in_range(restrictor.get(f)))
+  const std::uint64_t w = load_le(f);
+  if (command_crc.get(f, w) != e2e_crc(f, command_crc)) return Drop::crc;
+  if (!solenoid_a.in_range(solenoid_a.get(f, w)) || !solenoid_b.in_range(solenoid_b.get(f, w)) ||
+      !restrictor.in_range(restrictor.get(f, w)))
     return Drop::range;
   return std::nullopt;
 }
 
 std::optional<Drop> BenchLayout::check_sensors(const can::Frame& f) const noexcept {
   if (f.remote || f.len != sensors_len) return Drop::dlc;
-  if (sensors_crc.get(f) != e2e_crc(f, sensors_crc)) return Drop::crc;
-  if (!pilot.in_range(pilot.get(f)) || !supply.in_range(supply.get(f))) return Drop::range;
+  const std::uint64_t w = load_le(f);
+  if (sensors_crc.get(f, w) != e2e_crc(f, sensors_crc)) return Drop::crc;
+  if (!pilot.in_range(pilot.get(f, w)) || !supply.in_range(supply.get(f, w))) return Drop::range;
   return std::nullopt;
 }
 

@@ -48,6 +48,11 @@ class BitField {
   std::uint64_t get(const can::Frame& f) const noexcept {
     return codec_.read_raw({f.data.data(), can::Frame::kMaxClassicLen}).value_or(0);
   }
+  /// The same raw bits from the frame's 8 data bytes loaded as one little-endian word `le`
+  /// (one shift and mask for an Intel field; the codec for a Motorola one).
+  std::uint64_t get(const can::Frame& f, std::uint64_t le) const noexcept {
+    return intel_ ? (le >> shift_) & mask_ : get(f);
+  }
   /// physical → raw: rounds to nearest, clamps to the DBC range and the bit range.
   std::uint64_t to_raw(double physical) const noexcept {
     bool clamped = false;
@@ -62,6 +67,9 @@ class BitField {
   void set_raw_range() noexcept;
   can::SignalCodec codec_;
   std::uint64_t raw_lo_ = 0, raw_hi_ = ~std::uint64_t{0};
+  bool intel_ = false;
+  std::uint32_t shift_ = 0;
+  std::uint64_t mask_ = 0;
 };
 
 /// Decoded BenchCommand.
@@ -118,6 +126,13 @@ struct BenchLayout {
   /// Current command quantisation: what the slave decodes for a commanded current [mA].
   double quantize_current(double mA) const noexcept { return solenoid_a.to_physical(solenoid_a.to_raw(mA)); }
 };
+
+/// The 8 data bytes of a frame as one little-endian word (byte 0 = bits 0..7).
+inline std::uint64_t load_le(const can::Frame& f) noexcept {
+  std::uint64_t w = 0;
+  for (std::size_t i = 0; i < 8; ++i) w |= static_cast<std::uint64_t>(f.data[i]) << (8 * i);
+  return w;
+}
 
 /// Counter distance b − a mod 2¹⁶ (1 = the next frame).
 inline std::uint16_t counter_delta(std::uint16_t a, std::uint16_t b) noexcept {
