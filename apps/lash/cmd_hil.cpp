@@ -188,6 +188,15 @@ json events_json(std::span<const hil::NodeEvent> events) {
   return ev;
 }
 
+void write_events(const std::string& path, std::span<const hil::NodeEvent> events) {
+  AtomicFile f(path);
+  f.stream() << "step,t_s,event,from,to\n";
+  for (const auto& e : events)
+    f.stream() << e.step << ',' << format_double(e.t_s) << ',' << to_string(e.kind) << ',' << to_string(e.from) << ','
+               << to_string(e.to) << '\n';
+  f.commit();
+}
+
 json controller_json(const can::ControllerBus& ctl) {
   const auto& cs = ctl.controller_stats();
   return json{{"rx_overflows", cs.rx_overflows}, {"tx_overflows", cs.tx_overflows}, {"tx_failures", cs.tx_failures},
@@ -293,6 +302,7 @@ int run_slave(const SlaveOptions& o) {
   j["dto_replies"] = slave.dto_replies();
   j["seed"] = s.plant.seed;
   if (!o.stats.empty()) write_json(o.stats, j);
+  write_events(std::filesystem::path(o.log).replace_extension("").string() + ".events.csv", slave.events());
   const auto tet = loop.tet_us();
   fmt::print(stderr,
              "lash hil slave: {} steps ({}), TET mean {:.2f} us max {:.2f} us (CAN I/O mean {:.2f} us), overruns {}, "
@@ -326,14 +336,6 @@ hil::MasterConfig master_config(const hil::BenchSettings& s, const std::string& 
   return mc;
 }
 
-void write_events(const std::string& path, std::span<const hil::MasterEvent> events) {
-  AtomicFile f(path);
-  f.stream() << "step,t_s,event,from,to\n";
-  for (const auto& e : events)
-    f.stream() << e.step << ',' << format_double(e.t_s) << ',' << to_string(e.kind) << ',' << to_string(e.from) << ','
-               << to_string(e.to) << '\n';
-  f.commit();
-}
 
 int run_master(const MasterOptions& o) {
   install_stop_handlers();
@@ -782,7 +784,9 @@ int run_run(const RunOptions& o) {
       fmt::print("step response: no reference step held >= 0.5 s in this run\n");
     fmt::print("max |emulation - simulation|: {} kPa, {} mA over {} steps ({} steps used an off-schedule frame)\n",
                format_double(diff.max_abs_diff_kPa), format_double(diff.max_abs_diff_mA), diff.compared, off.size());
-    fmt::print("logs in {}/ (master.csv, master.events.csv, master_bus.log, slave.csv, *.json, report.json)\n", dir);
+    fmt::print("logs in {}/ (master.csv, master.events.csv, master_bus.log, slave.csv, slave.events.csv, *.json, "
+               "report.json)\n",
+               dir);
   }
   return kExitOk;
 }

@@ -95,6 +95,7 @@ bool SlaveNode::wait_connect(can::Bus& bus, std::chrono::nanoseconds timeout) {
     if (!f) return false;
     if (layout_.is_connect(*f)) {
       reply_dto(bus);
+      if (state_ == SlaveState::startup) go(SlaveState::connected, NodeEventKind::connected, 0.0);
       return true;
     }
     ++ignored_;
@@ -142,6 +143,7 @@ void SlaveNode::step(can::Bus& bus, double now_s) noexcept {
   const auto ramp = [&]() noexcept { current_mA_ = std::max(cfg_.current_min_mA, current_mA_ - ramp_step_mA_); };
   const bool recovered = watch_.good_run >= cfg_.e2e.recovery_frames;
   switch (state_) {
+    case SlaveState::startup:  // stepped without a CONNECT (simulations): as connected
     case SlaveState::connected:
       if (fresh && !bad) {
         go(SlaveState::running, NodeEventKind::input_valid, now_s);

@@ -90,7 +90,7 @@ using MasterEventKind = NodeEventKind;
 
 struct NodeEvent {
   std::uint32_t step = 0;   ///< loop step k
-  double t_s = 0.0;         ///< time the step ran [s]
+  double t_s = 0.0;         ///< time the step ran [s] (slave's CONNECT: 0, before its first step)
   NodeEventKind kind = NodeEventKind::connected;
   NodeState from = NodeState::startup, to = NodeState::startup;
 };
@@ -140,7 +140,7 @@ struct SlaveConfig {
 /// One slave step.
 struct SlaveStepLog {
   std::uint32_t step = 0;
-  SlaveState state = SlaveState::connected;
+  SlaveState state = SlaveState::startup;
   std::uint64_t command_counter = 0;      ///< the last accepted command's counter, unwrapped
   bool command_fresh = false;             ///< a plausible new command frame arrived for this step
   std::uint16_t dropped = 0;              ///< implausible command frames dropped in this step
@@ -180,7 +180,7 @@ class SlaveNode {
   SeqTracker cmd_;
   InputWatch watch_;
   EventLog events_;
-  SlaveState state_ = SlaveState::connected;
+  SlaveState state_ = SlaveState::startup;
   double command_mA_ = 0.0;   ///< last plausible command
   double current_mA_ = 0.0;   ///< driven current
   double ramp_step_mA_ = 0.0;
