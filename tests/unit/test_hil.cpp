@@ -529,3 +529,57 @@ TEST(HilReport, FindStepSkipsShortLevels) {
   EXPECT_NEAR(w->t_step_s, 1.1, 1e-12);
   EXPECT_FALSE(find_step(std::vector<double>(50, 3.0), 0.01).has_value());
 }
+
+// Random frames with the command's identifier (seeded): random DLCs and payloads, half of
+// them with a CRC fixed up so that the range and counter checks are reached, a quarter with
+// the next counter. Whatever arrives, the slave drives 0..2000 mA at every step, every
+// frame is either accepted or dropped with a reason, and nothing implausible is applied:
+// every accepted value is in the DBC range.
+TEST(HilSlave, RandomFramesNeverDriveOutsideTheRange) {
+  const double T = 0.005;
+  BenchLayout L;
+  SlaveConfig sc = slave_config(T);
+  sc.log_capacity = 20000;
+  SlaveNode slave(L, sc);
+  MemLink link;
+  link.a().send(L.pack_connect(0));
+  ASSERT_TRUE(slave.wait_connect(link.b(), std::chrono::nanoseconds(0)));
+  std::uint64_t x = 0x9E3779B97F4A7C15ull;  // splitmix64
+  auto rnd = [&x]() {
+    std::uint64_t z = (x += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+  };
+  std::uint8_t next = 0;
+  std::uint64_t sent = 0;
+  for (int k = 0; k < 20000; ++k) {
+    const int n = static_cast<int>(rnd() % 4);
+    for (int j = 0; j < n; ++j) {
+      can::Frame f;
+      f.id = L.command_id;
+      const std::uint64_t r = rnd();
+      f.len = static_cast<std::uint8_t>(r % 16 < 12 ? 8 : r % 9);
+      const std::uint64_t payload = rnd();
+      for (std::size_t b = 0; b < 8; ++b) f.data[b] = static_cast<std::uint8_t>(payload >> (8 * b));
+      if ((r >> 8) % 4 == 0) L.command_counter.put(f, next);
+      if ((r >> 12) % 2 == 0) L.command_crc.put(f, BenchLayout::e2e_crc(f, L.command_crc));
+      if ((r >> 16) % 4 == 0)  // a plausible frame: in range, the next counter
+        f = L.pack_command({static_cast<double>((r >> 20) % 20001) * 0.1, 0.0, 0.0, next++});
+      link.a().send(f);
+      ++sent;
+    }
+    slave.step(link.b(), k * T);
+  }
+  const auto& c = slave.commands();
+  EXPECT_EQ(c.received, sent);
+  EXPECT_EQ(c.accepted + c.drops.total(), sent);
+  EXPECT_GT(c.accepted, 100u);
+  for (std::size_t i = 0; i < kDropReasons; ++i) EXPECT_GT(c.drops.n[i], 0u) << to_string(static_cast<Drop>(i));
+  bool ran = false;
+  for (const auto& l : slave.log()) {
+    ASSERT_TRUE(l.current_mA >= 0.0 && l.current_mA <= 2000.0) << l.step;
+    ran = ran || l.state == SlaveState::running;
+  }
+  EXPECT_TRUE(ran);
+}
