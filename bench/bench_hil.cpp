@@ -96,7 +96,7 @@ void BM_HilPlausibilitySensorFrame(benchmark::State& state) {
   for (auto _ : state) {
     const can::Frame& f = frames[i++ & 1023];
     bool ok = !L.check_sensors(f).has_value();
-    ok = ok && t.on_counter(static_cast<std::uint16_t>(L.sensor_counter.get(f, load_le(f))));
+    ok = ok && t.on_counter(static_cast<std::uint16_t>(L.checks.sensor_counter.get(L.sensor_counter, f, load_le(f))));
     benchmark::DoNotOptimize(ok);
   }
   if (t.accepted + t.drops.total() != static_cast<std::uint64_t>(state.iterations())) state.SkipWithError("frames not counted");
@@ -114,7 +114,7 @@ void BM_HilPlausibilityCommandFrame(benchmark::State& state) {
   for (auto _ : state) {
     const can::Frame& f = frames[i++ & 1023];
     bool ok = !L.check_command(f).has_value();
-    ok = ok && t.on_counter(static_cast<std::uint16_t>(L.command_counter.get(f, load_le(f))));
+    ok = ok && t.on_counter(static_cast<std::uint16_t>(L.checks.command_counter.get(L.command_counter, f, load_le(f))));
     benchmark::DoNotOptimize(ok);
   }
   state.SetLabel("DLC + CRC-8 + 3 ranges + counter of one BenchCommand frame");

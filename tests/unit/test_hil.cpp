@@ -120,14 +120,14 @@ TEST(HilLayout, ShippedDbcMatchesBuiltInLayout) {
   // The DBC's ranges: [0|2000] mA at 0.1 mA/bit → raw 0..20000; duty [5|95] % at 100/65535 %/bit
   // → raw ceil(5·655.35 = 3276.75) = 3277 .. floor(95·655.35 = 62258.25) = 62258.
   for (const BenchLayout* l : {&d, &b}) {
-    EXPECT_TRUE(l->solenoid_a.in_range(20000));
-    EXPECT_FALSE(l->solenoid_a.in_range(20001));
-    EXPECT_TRUE(l->pilot.in_range(3277));
-    EXPECT_FALSE(l->pilot.in_range(3276));
-    EXPECT_TRUE(l->pilot.in_range(62258));
-    EXPECT_FALSE(l->pilot.in_range(62259));
-    EXPECT_TRUE(l->supply.in_range(0));
-    EXPECT_TRUE(l->command_counter.in_range(255));
+    EXPECT_TRUE(l->checks.solenoid_a.in_range(20000));
+    EXPECT_FALSE(l->checks.solenoid_a.in_range(20001));
+    EXPECT_TRUE(l->checks.pilot.in_range(3277));
+    EXPECT_FALSE(l->checks.pilot.in_range(3276));
+    EXPECT_TRUE(l->checks.pilot.in_range(62258));
+    EXPECT_FALSE(l->checks.pilot.in_range(62259));
+    EXPECT_TRUE(l->checks.supply.in_range(0));
+    EXPECT_TRUE(l->checks.command_counter.in_range(255));
   }
   CommandMsg c{1234.5, 0, 0, 77};
   SensorMsg s{17343, 0, 9};

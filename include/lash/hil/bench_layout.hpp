@@ -9,7 +9,8 @@
 ///                                  Command_CRC
 ///   BenchSensors (slave → master): PilotPressure_Duty, SupplyPressure_Duty
 ///                                  [uint16 duty code], Sensor_Counter (16 bit), Sensor_CRC
-///   CCP_CRO / CCP_DTO: the CONNECT handshake (CRO_CMD = 0x01; DTO_PID = 0xFF).
+///   CCP_CRO / CCP_DTO: the CONNECT handshake, can::ccp::Layout (can/ccp.hpp),
+///                      which BenchLayout extends.
 ///
 /// The pilot pressure travels as the SPEC B1 sensor code
 /// raw = round((p/48.82 + 5.98)·(2¹⁶ − 1)/100); both ends convert with
@@ -24,53 +25,39 @@
 #include <filesystem>
 #include <optional>
 
-#include "lash/can/codec.hpp"
-#include "lash/can/dbc.hpp"
+#include "lash/can/bit_field.hpp"
+#include "lash/can/ccp.hpp"
 #include "lash/can/frame.hpp"
 #include "lash/hil/e2e.hpp"
 
 namespace lash::hil {
 
-/// One signal of a frame as the DBC places it, coded by the CAN layer's SignalCodec
-/// (can/codec.hpp: Intel/Motorola bit placement, physical → raw rounding to nearest and
-/// clamping to the DBC range). All members are noexcept and O(1).
-class BitField {
- public:
-  /// An unsigned Intel signal: start bit (LSB), length, factor, physical range [lo, hi]
-  /// (lo == hi: no range). `intel = false` places it Motorola (start bit = MSB).
-  BitField(std::uint32_t start_bit, std::uint32_t length, double factor, double lo = 0.0, double hi = 0.0,
-           bool intel = true);
-  explicit BitField(const can::dbc::Signal& signal);
+/// One signal of a frame as the DBC places it (can/bit_field.hpp).
+using can::BitField;
 
-  void put(can::Frame& f, std::uint64_t raw) const noexcept {
-    codec_.write_raw({f.data.data(), can::Frame::kMaxClassicLen}, raw);
-  }
-  std::uint64_t get(const can::Frame& f) const noexcept {
-    return codec_.read_raw({f.data.data(), can::Frame::kMaxClassicLen}).value_or(0);
-  }
-  /// The same raw bits from the frame's 8 data bytes loaded as one little-endian word `le`
-  /// (one shift and mask for an Intel field; the codec for a Motorola one).
-  std::uint64_t get(const can::Frame& f, std::uint64_t le) const noexcept {
-    return intel_ ? (le >> shift_) & mask_ : get(f);
-  }
-  /// physical → raw: rounds to nearest, clamps to the DBC range and the bit range.
-  std::uint64_t to_raw(double physical) const noexcept {
-    bool clamped = false;
-    return codec_.to_raw(physical, clamped);
-  }
-  double to_physical(std::uint64_t raw) const noexcept { return codec_.to_physical(raw); }
-  /// raw is inside the DBC's physical [min|max] (always true when the DBC gives no range).
-  bool in_range(std::uint64_t raw) const noexcept { return raw >= raw_lo_ && raw <= raw_hi_; }
-  const can::dbc::Signal& signal() const noexcept { return codec_.signal(); }
+/// A field's plausibility data, precomputed from its BitField: where its bits sit in the
+/// frame's 8 data bytes read as one little-endian word (Intel fields), and the raw codes
+/// whose physical value raw·factor + offset lies in the DBC's [min|max] (a relative
+/// tolerance of 1e-9 absorbs decimal factors; no range given = every code).
+struct FieldCheck {
+  bool intel = false;
+  std::uint32_t shift = 0;
+  std::uint64_t mask = 0, lo = 0, hi = ~std::uint64_t{0};
 
- private:
-  void set_raw_range() noexcept;
-  can::SignalCodec codec_;
-  std::uint64_t raw_lo_ = 0, raw_hi_ = ~std::uint64_t{0};
-  bool intel_ = false;
-  std::uint32_t shift_ = 0;
-  std::uint64_t mask_ = 0;
+  static FieldCheck of(const BitField& field) noexcept;
+  /// The field's raw bits: one shift and mask of `le` for an Intel field, the codec otherwise.
+  std::uint64_t get(const BitField& field, const can::Frame& f, std::uint64_t le) const noexcept {
+    return intel ? (le >> shift) & mask : field.get(f);
+  }
+  bool in_range(std::uint64_t raw) const noexcept { return raw >= lo && raw <= hi; }
 };
+
+/// The 8 data bytes of a frame as one little-endian word (byte 0 = bits 0..7).
+inline std::uint64_t load_le(const can::Frame& f) noexcept {
+  std::uint64_t w = 0;
+  for (std::size_t i = 0; i < 8; ++i) w |= static_cast<std::uint64_t>(f.data[i]) << (8 * i);
+  return w;
+}
 
 /// Decoded BenchCommand.
 struct CommandMsg {
@@ -87,19 +74,24 @@ struct SensorMsg {
   std::uint16_t counter = 0;
 };
 
-struct BenchLayout {
-  std::uint32_t command_id = 0x100, sensors_id = 0x200, cro_id = 0x7E0, dto_id = 0x7E1;
-  std::uint8_t command_len = 8, sensors_len = 8, cro_len = 8;
+/// The bench's frames: its own command and sensor messages plus the CCP handshake
+/// (cro_id, dto_id, pack_connect, is_connect, is_connect_ack from can::ccp::Layout).
+struct BenchLayout : can::ccp::Layout {
+  std::uint32_t command_id = 0x100, sensors_id = 0x200;
+  std::uint8_t command_len = 8, sensors_len = 8;
   // Defaults: the layout of config/hydraulic_bench.dbc.
   BitField solenoid_a{0, 16, 0.1, 0, 2000}, solenoid_b{16, 16, 0.1, 0, 2000}, restrictor{32, 16, 0.1, 0, 2000},
       command_counter{48, 8, 1.0}, command_crc{56, 8, 1.0};
   BitField pilot{0, 16, 0.00152590218966964, 5, 95}, supply{16, 16, 0.00152590218966964, 0, 100},
       sensor_counter{32, 16, 1.0}, sensors_crc{56, 8, 1.0};
-  BitField cro_cmd{0, 8, 1.0}, cro_ctr{8, 8, 1.0}, dto_pid{0, 8, 1.0}, dto_err{8, 8, 1.0};
+
+  BenchLayout() { refresh_checks(); }
+  /// Recomputes the plausibility data of the fields above; call it after changing one.
+  void refresh_checks() noexcept;
 
   /// Reads the layout from a DBC file. Throws lash::InputError naming the file and the
-  /// missing message/signal (a counter of 4..16 bits, a CRC that is not one whole byte of
-  /// the frame). Not real-time safe.
+  /// missing message/signal (a command counter of 4..16 bits, a sensor counter of 16 bits,
+  /// a CRC that is not one whole byte of the frame). Not real-time safe.
   static BenchLayout from_dbc(const std::filesystem::path& dbc_file);
 
   /// The counter goes on the bus modulo 2^(counter bits); the CRC is computed last.
@@ -116,23 +108,15 @@ struct BenchLayout {
   static std::uint8_t e2e_crc(const can::Frame& f, const BitField& crc) noexcept;
   std::uint32_t command_counter_bits() const noexcept { return command_counter.signal().length; }
   std::uint32_t sensor_counter_bits() const noexcept { return sensor_counter.signal().length; }
-
-  /// CCP CONNECT request (CRO_CMD = 0x01, counter ctr).
-  can::Frame pack_connect(std::uint8_t ctr) const noexcept;
-  bool is_connect(const can::Frame& f) const noexcept;
-  /// A positive command-return DTO (PID 0xFF, error code 0x00).
-  bool is_connect_ack(const can::Frame& f) const noexcept;
+  /// Plausibility data of the fields (refresh_checks()).
+  struct Checks {
+    FieldCheck solenoid_a, solenoid_b, restrictor, command_counter, command_crc, pilot, supply, sensor_counter,
+        sensors_crc;
+  } checks;
 
   /// Current command quantisation: what the slave decodes for a commanded current [mA].
   double quantize_current(double mA) const noexcept { return solenoid_a.to_physical(solenoid_a.to_raw(mA)); }
 };
-
-/// The 8 data bytes of a frame as one little-endian word (byte 0 = bits 0..7).
-inline std::uint64_t load_le(const can::Frame& f) noexcept {
-  std::uint64_t w = 0;
-  for (std::size_t i = 0; i < 8; ++i) w |= static_cast<std::uint64_t>(f.data[i]) << (8 * i);
-  return w;
-}
 
 /// Counter distance b − a mod 2¹⁶ (1 = the next frame).
 inline std::uint16_t counter_delta(std::uint16_t a, std::uint16_t b) noexcept {
