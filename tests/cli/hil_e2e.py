@@ -27,7 +27,6 @@ import hil_netns  # noqa: E402
 
 hil_netns.enter_private_netns()
 import can  # noqa: E402
-import crcmod  # noqa: E402
 
 LASH = hil_netns.lash()
 BUS = "udp:239.74.163.2:43113"
@@ -36,25 +35,14 @@ RUNNING, DEGRADED, SAFE = 2, 3, 4  # the state column (nodes.hpp, docs/hil.md)
 out = tempfile.mkdtemp(prefix="lash_hil_e2e_")
 
 
-def crc8_j1850(data):
-    reg = 0xFF
-    for b in data:
-        reg ^= b
-        for _ in range(8):
-            reg = ((reg << 1) ^ 0x1D) & 0xFF if reg & 0x80 else (reg << 1) & 0xFF
-    return reg ^ 0xFF
-
-
-assert crc8_j1850(b"123456789") == 0x4B
-_crcmod = crcmod.mkCrcFun(0x11D, initCrc=0x00, rev=False, xorOut=0xFF)
-assert all(_crcmod(p) == crc8_j1850(p) for p in (b"123456789", bytes(range(9)), b"\x00\x01\x02"))
+hil_netns.check_crc8_j1850()
 
 
 def command(mA_raw, counter, crc_ok=True):
     """BenchCommand by hand (config/hydraulic_bench.dbc): SolenoidA 0|16 (0.1 mA), B 16|16,
     restrictor 32|16, counter 48|8, CRC 56|8 over 00 01 + bytes 0-6."""
     body = bytes([mA_raw & 0xFF, mA_raw >> 8, 0, 0, 0, 0, counter & 0xFF])
-    crc = crc8_j1850(bytes([0x00, 0x01]) + body)
+    crc = hil_netns.e2e_crc(0x100, body + b"\x00", 7)
     return body + bytes([crc if crc_ok else crc ^ 0xA5])
 
 

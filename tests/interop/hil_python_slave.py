@@ -39,31 +39,8 @@ assert recorded, "no DTO in the recorded log"
 T = 0.005
 
 
-def crc8_j1850(data):
-    """CRC-8 SAE J1850, bit by bit: poly 0x1D, init 0xFF, xorout 0xFF, MSB first."""
-    reg = 0xFF
-    for b in data:
-        reg ^= b
-        for _ in range(8):
-            reg = ((reg << 1) ^ 0x1D) & 0xFF if reg & 0x80 else (reg << 1) & 0xFF
-    return reg ^ 0xFF
-
-
-import crcmod  # noqa: E402
-
-assert crc8_j1850(b"123456789") == 0x4B
-_crcmod = crcmod.mkCrcFun(0x11D, initCrc=0x00, rev=False, xorOut=0xFF)  # crcmod's init is pre-XORed
-for probe in (b"123456789", bytes(range(9)), bytes([0xFF] * 8)):
-    assert _crcmod(probe) == crc8_j1850(probe), probe
-
-
-def e2e_crc(arbitration_id, data, crc_byte):
-    """The bench DBC's E2E CRC: data ID (identifier low byte, high byte) + payload without the CRC byte."""
-    body = bytes([arbitration_id & 0xFF, (arbitration_id >> 8) & 0xFF]) + bytes(
-        b for i, b in enumerate(data) if i != crc_byte)
-    return crc8_j1850(body)
-
-
+hil_netns.check_crc8_j1850()
+e2e_crc = hil_netns.e2e_crc
 CMD_CRC_BYTE = CMD.signal_by_name("Command_CRC").start_bit // 8
 SEN_CRC_BYTE = SEN.signal_by_name("Sensor_CRC").start_bit // 8
 
