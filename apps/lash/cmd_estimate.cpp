@@ -7,11 +7,11 @@
 #include <unistd.h>
 
 #include <fmt/core.h>
-#include <nlohmann/json.hpp>
 
 #include "cli_common.hpp"
 #include "plot.hpp"
 #include "lash/identify/any_estimator.hpp"
+#include "lash/identify/estimate_report.hpp"
 #include "lash/identify/config_file.hpp"
 #include "lash/identify/data.hpp"
 
@@ -50,27 +50,6 @@ std::vector<std::string> split_names(const std::string& text) {
   if (out.size() != 3) throw InputError("", 0, "--columns", "expected three names t,v,y, got '" + text + "'");
   return out;
 }
-
-nlohmann::ordered_json num(double x) { return std::isfinite(x) ? nlohmann::ordered_json(x) : nlohmann::ordered_json(); }
-
-/// One side's (linear: the model's) keys: a1, b1, c, d, identified, updates as before, plus
-/// the verdict's reason (null when identified), K and tau_s.
-void put_side(nlohmann::ordered_json& j, const EstimateReport& r, const SideReport& s) {
-  j["a1"] = num(s.params.a1);
-  j["b1"] = num(s.params.b1);
-  if (r.has_c) j["c"] = num(s.params.c);
-  if (r.has_side_d) j["d"] = num(s.params.d);
-  j["identified"] = s.params.identified;
-  nlohmann::ordered_json u = nlohmann::ordered_json::object();
-  for (const auto& [k, n] : s.updates) u[k] = n;
-  j["updates"] = u;
-  j["reason"] = s.params.identified ? nlohmann::ordered_json() : nlohmann::ordered_json(to_string(s.params.reason));
-  j["K"] = num(s.K);
-  j["tau_s"] = num(s.tau_s);
-}
-
-/// 6 significant digits for a person ("-" for a missing value).
-std::string sig(double x) { return std::isfinite(x) ? fmt::format("{:.6g}", x) : std::string("-"); }
 
 int run(const EstimateOptions& o) {
   EstimatorConfig cfg;
@@ -139,11 +118,12 @@ int run(const EstimateOptions& o) {
   cfg.fit_start_s = job.nrmse_t0_s;  // the verdict's fit window starts where the reported NRMSE's does
   const bool keep = !o.out.empty() || !o.plot.empty();
   const auto t_start = std::chrono::steady_clock::now();
-  const EstimationRun run = run_estimator(cfg, rec.v(), rec.y(), keep);
+  EstimationRun run = run_estimator(cfg, rec.v(), rec.y(), keep);
   const double elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   if (o.timing)
     fmt::print(stderr, "lash estimate: estimator ran {} samples in {} s ({:.3g} M samples/s)\n", rec.v().size(),
                format_double(elapsed_s), static_cast<double>(rec.v().size()) / elapsed_s * 1e-6);
+  add_intervals(run, cfg, rec.v(), rec.y());
   const auto& t = rec.t();
   const double t1 = job.nrmse_t1_s < 0 ? t.back() : job.nrmse_t1_s;
   const double fit = nrmse(t, rec.y(), run.ysim, job.nrmse_t0_s, t1);
@@ -191,51 +171,9 @@ int run(const EstimateOptions& o) {
     if (!tmp.empty()) std::filesystem::remove(tmp);
   }
 
-  const EstimateReport& r = run.report;
-  if (o.json) {
-    nlohmann::ordered_json j;
-    j["model"] = to_string(r.model);
-    j["samples"] = r.samples;
-    if (r.model == ModelKind::linear) {
-      put_side(j, r, r.right);
-    } else {
-      put_side(j["right"], r, r.right);
-      put_side(j["left"], r, r.left);
-    }
-    if (r.has_shared_d) {
-      j["d"] = num(r.d);
-      nlohmann::ordered_json u = nlohmann::ordered_json::object();
-      for (const auto& [k, n] : r.d_updates) u[k] = n;
-      j["d_updates"] = u;
-      j["d_reason"] = r.d_reason == Reason::none ? nlohmann::ordered_json() : nlohmann::ordered_json(to_string(r.d_reason));
-    }
-    j["nrmse"] = num(fit);
-    j["nrmse_pct"] = num(100.0 * fit);
-    j["nrmse_window_s"] = {job.nrmse_t0_s, t1};
-    fmt::print("{}\n", j.dump());
-  } else {
-    fmt::print("model {}: {} samples at dt = {} s, {} skipped\n", to_string(r.model), r.samples,
-               format_double(rec.dt_s), r.skipped);
-    auto show = [&](const char* name, const SideReport& s) {
-      std::string line = fmt::format("{:>6}: a1 = {}  b1 = {}", name, sig(s.params.a1), sig(s.params.b1));
-      if (r.has_c) line += "  c = " + sig(s.params.c);
-      if (r.has_side_d) line += "  d = " + sig(s.params.d);
-      line += "  K = " + sig(s.K) + "  tau = " + sig(s.tau_s) + " s";
-      line += s.params.identified ? "  identified" : fmt::format("  NOT identified ({})", to_string(s.params.reason));
-      line += "  updates";
-      for (const auto& [k, n] : s.updates) line += fmt::format(" {}:{}", k, n);
-      fmt::print("{}\n", line);
-    };
-    if (r.model == ModelKind::linear) show("model", r.right);
-    else {
-      show("right", r.right);
-      show("left", r.left);
-    }
-    if (r.has_shared_d) fmt::print("     d = {} (updates +:{} -:{}){}\n", sig(r.d), r.d_updates[0].second,
-                                   r.d_updates[1].second,
-                                   r.d_reason == Reason::none ? "" : fmt::format("  NOT identified ({})", to_string(r.d_reason)));
-    fmt::print("NRMSE of the simulated output over [{}, {}] s: {} %\n", sig(job.nrmse_t0_s), sig(t1), sig(100.0 * fit));
-  }
+  const ReportFit rf{fit, job.nrmse_t0_s, t1};
+  if (o.json) fmt::print("{}\n", estimate_json(run.report, rf));
+  else fmt::print("{}", estimate_text(run.report, rec.dt_s, rf));
   return kExitOk;
 }
 
