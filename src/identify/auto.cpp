@@ -165,6 +165,12 @@ DataTraits analyse_record(std::span<const double> v, std::span<const double> y, 
     rates.reserve(yf.size());
     for (std::size_t k = 40; k < yf.size(); ++k) rates.push_back(std::fabs(yf[k] - yf[k - 40]) / (40.0 * dt_s));
     d.ydot_p90 = quantile(rates, 0.9);
+    std::vector<double> acc;
+    for (std::size_t k = 2; k < yf.size(); ++k) {
+      const double d1 = yf[k] - yf[k - 1], d0 = yf[k - 1] - yf[k - 2];
+      if (d1 * d0 > 0.0) acc.push_back(std::fabs(d1 - d0) / (dt_s * dt_s));
+    }
+    d.yddot_p90 = quantile(acc, 0.9);
   }
   // quantised: the nonzero steps are integer multiples of the smallest one
   for (std::size_t k = 1; k < yf.size(); ++k) {
@@ -218,9 +224,23 @@ void tune_to_data(EstimatorConfig& c, const DataTraits& d) {
     case ModelKind::coupled_carts:
       // a quantised position (linear scale) gives a quantised velocity: average it over 1000 samples
       if (d.quantum > 0.0) c.rls.lambda = 0.999;
+      // stage 1 leaves out the pin's impacts: accelerations well above the record's usual ones
+      if (d.yddot_p90 > 0.0) c.accel_limit = 3.0 * d.yddot_p90;
       break;
-    case ModelKind::input_deadzone:
+    case ModelKind::input_deadzone: {
+      // Projection box from the record's scales (Goodwin & Sin §3.7): a1 ∈ [−1, 0], 0 < b1 ≤ B and
+      // |e| = |b1·c| ≤ B·max|v|, B = 2·span(y)/span(v) (at least twice the largest static gain the
+      // record can show). Without it a side with few samples (amplitude just above the deadzone)
+      // can run away under forgetting (E4: b1 ~ 1e74).
+      const double vspan = d.v_hi - d.v_lo;
+      if (vspan > 0.0 && d.y_span > 0.0) {
+        const double B = 2.0 * d.y_span / vspan;
+        const double E = B * std::max(std::fabs(d.v_lo), std::fabs(d.v_hi));
+        c.rls.lower = {-1.0, 1e-4 * B, -E};
+        c.rls.upper = {0.0, B, E};
+      }
       break;
+    }
   }
 }
 
@@ -272,6 +292,7 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, std::span<const double> v, st
 
 std::array<double, 2> search_guesses(const EstimatorConfig& cfg0, std::span<const double> v,
                                      std::span<const double> y) {
+  if (!uses_guesses(cfg0.model)) return {kInf, -kInf};
   const DataTraits d = analyse_record(v, y, cfg0.dt_s);
   const double hi = std::max(d.v_hi, 0.0), lo = std::min(d.v_lo, 0.0);
   const double span = hi - lo;

@@ -47,6 +47,9 @@ struct DataTraits {
   /// 90 % quantile of |ẏ| over 40-sample windows, |y(k) − y(k−40)|/(40·T) [y unit/s]: how fast the
   /// output moves when it moves (the scale of the switching dead band).
   double ydot_p90 = 0.0;
+  /// 90 % quantile of |ÿ| (second difference / T²) over samples where y moved in the same
+  /// direction three samples in a row [y unit/s²] (coupled carts: the acceleration gate's scale).
+  double yddot_p90 = 0.0;
   /// Smallest step of y (encoder resolution) [y unit]; 0 when y is not visibly quantised.
   double quantum = 0.0;
 };
