@@ -58,6 +58,7 @@ int run(const EstimateOptions& o) {
     EstimationJob j;
     const toml::table root = parse_toml_file(o.config);
     TomlTable t(root, o.config);
+    (void)t.string_opt("preset");
     read_estimator_config(t, probe, &j);
     model = probe.model;
   } else {
@@ -116,7 +117,7 @@ int run(const EstimateOptions& o) {
       plot_estimate(csv, o.plot,
                     fmt::format("lash estimate --model {} {}", to_string(cfg.model),
                                 std::filesystem::path(o.data).filename().string()),
-                    run.param_names);
+                    run.param_names, t.back());
     } catch (...) {
       if (!tmp.empty()) std::filesystem::remove(tmp);
       throw;
@@ -233,6 +234,7 @@ Command add_estimate(CLI::App& app) {
       opt->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
   return {sub, [o, sub] {
             o->given.clear();
+            o->preset_given = sub->get_option("--preset")->count() > 0;
             for (const char* n : {"guess-left", "guess-right", "pooled", "direction-run", "method", "iv-delay",
                                   "accel-limit", "stage2-start", "zero-threshold", "derivative-threshold",
                                   "derivative-filter-length", "derivative-prefilter-length", "align-delay"})

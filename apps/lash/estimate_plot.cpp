@@ -25,7 +25,7 @@ std::string side_title(const std::string& col) {
 }  // namespace
 
 void plot_estimate(const std::string& csv, const std::string& png, const std::string& title,
-                   const std::vector<std::string>& param_names) {
+                   const std::vector<std::string>& param_names, double t_end_s) {
   std::vector<Panel> panels;
   for (const auto& n : param_names) {
     const std::string base = n.substr(0, n.find('_'));
@@ -51,7 +51,8 @@ void plot_estimate(const std::string& csv, const std::string& png, const std::st
     }
     s += plot + "\n";
   }
-  s += "set xlabel 't [s]'\nset ylabel 'output y [y unit]'\n";
+  s += fmt::format("set xlabel 't [s] (last {:g} s)'\nset ylabel 'output y [y unit]'\nset xrange [{}:{}]\n",
+                   t_end_s > 20.0 ? 20.0 : t_end_s, t_end_s > 20.0 ? t_end_s - 20.0 : 0.0, t_end_s);
   s += fmt::format(
       "plot '{0}' using (column('t')):(column('y')) with lines lc rgb '#999999' title 'y measured', "
       "'{0}' using (column('t')):(column('y_sim')) with lines lw 1.2 lc rgb '#d62728' title 'y free run'\n",

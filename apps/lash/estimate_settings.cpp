@@ -25,6 +25,17 @@ std::vector<std::string> split_names(const std::string& text) {
 /// preset → data-dependent settings (lash preset, when the record is known) → --config → options.
 EstimatorConfig assemble(const EstimateOptions& o, ModelKind model, Preset preset, const Record* rec,
                          EstimationJob& job) {
+  if (!o.config.empty() && !o.preset_given) {  // a `preset` key in the file applies unless --preset is given
+    const toml::table root = parse_toml_file(o.config);
+    TomlTable t(root, o.config);
+    if (auto p = t.string_opt("preset")) {
+      try {
+        preset = parse_preset(*p);
+      } catch (const std::invalid_argument& e) {
+        t.fail("preset", e.what());
+      }
+    }
+  }
   EstimatorConfig cfg = preset_config(model, preset);
   if (rec) {
     cfg.dt_s = rec->dt_s;
@@ -33,6 +44,7 @@ EstimatorConfig assemble(const EstimateOptions& o, ModelKind model, Preset prese
   if (!o.config.empty()) {
     const toml::table root = parse_toml_file(o.config);
     TomlTable t(root, o.config);
+    (void)t.string_opt("preset");
     read_estimator_config(t, cfg, &job);
   }
   cfg.model = model;

@@ -28,6 +28,7 @@ struct EstimateOptions {
   bool json = false;
   bool timing = false;
   std::string preset = "lash";
+  bool preset_given = false;  // --preset on the command line (beats a `preset` key in --config)
   bool print_config = false;
   double outlier_gate = 12.0;
   std::vector<std::string> given;  // options given on the command line (without dashes)

@@ -188,7 +188,6 @@ DataTraits analyse_record(std::span<const double> v, std::span<const double> y, 
 
 void tune_to_data(EstimatorConfig& c, const DataTraits& d) {
   c.dt_s = d.dt_s > 0.0 ? d.dt_s : c.dt_s;
-  const double n = static_cast<double>(d.samples);
   switch (c.model) {
     case ModelKind::deadzone_deadband: {
       // Dead band on ẏ: 3σ of the derivative filter's noise output (||h||₂ of
@@ -218,8 +217,9 @@ void tune_to_data(EstimatorConfig& c, const DataTraits& d) {
     }
     case ModelKind::output_deadzone:
     case ModelKind::linear:
-      // every sample of a record of a time-invariant plant counts: memory ≥ a third of the record
-      c.rls.lambda = 1.0 - 1.0 / std::max(2000.0, n / 3.0);
+      // a memory of 2 s: several time constants of a mechanical axis and a few reversals (E3 and
+      // EMPS at 1 kHz: λ = 0.9995; 10 s followed closed-loop noise less well on EMPS)
+      c.rls.lambda = std::clamp(1.0 - c.dt_s / 2.0, 0.99, 0.99995);
       break;
     case ModelKind::coupled_carts:
       // a quantised position (linear scale) gives a quantised velocity: average it over 1000 samples
@@ -331,11 +331,21 @@ std::string config_to_toml(const EstimatorConfig& c) {
   const auto tri = [&](const std::array<double, 3>& a) {
     return "[" + num(a[0]) + ", " + num(a[1]) + ", " + num(a[2]) + "]";
   };
+  // TOML files hold finite numbers only: a non-finite value (the "none" of a guess, a bound or the
+  // acceleration gate) is the default of every base, so it is written as a comment
+  const auto key = [&](const char* k, double x) {
+    if (!std::isfinite(x)) o << "# ";
+    o << k << " = " << num(x) << "\n";
+  };
+  const auto key3 = [&](const char* k, const std::array<double, 3>& a) {
+    if (!(std::isfinite(a[0]) && std::isfinite(a[1]) && std::isfinite(a[2]))) o << "# ";
+    o << k << " = " << tri(a) << "\n";
+  };
   o << "# lash estimate settings (docs/identification.md); lash estimate --config FILE reads them back\n";
   o << "model = \"" << to_string(c.model) << "\"\n";
   o << "method = \"" << to_string(c.method) << "\"\n";
-  o << "guess_left = " << num(c.guess_left) << "\n";
-  o << "guess_right = " << num(c.guess_right) << "\n";
+  key("guess_left", c.guess_left);
+  key("guess_right", c.guess_right);
   o << "pooled = " << (c.pooled ? "true" : "false") << "\n";
   o << "sim_side_by_sign = " << (c.sim_side_by_sign ? "true" : "false") << "\n";
   o << "iv_delay = " << c.iv_delay << "\n";
@@ -345,14 +355,14 @@ std::string config_to_toml(const EstimatorConfig& c) {
   o << "settle_tol = " << num(c.settle_tol) << "\n";
   o << "settle_updates = " << c.settle_updates << "\n";
   o << "zero_threshold = " << num(c.zero_threshold) << "\n";
-  o << "accel_limit = " << num(c.accel_limit) << "\n";
+  key("accel_limit", c.accel_limit);
   o << "stage2_start = " << num(c.stage2_start_s) << "\n\n";
   o << "[rls]\n";
   o << "lambda = " << num(c.rls.lambda) << "\n";
   o << "p0 = " << num(c.rls.p0) << "\n";
   o << "eta0 = " << tri(c.rls.eta0) << "\n";
-  o << "lower = " << tri(c.rls.lower) << "\n";
-  o << "upper = " << tri(c.rls.upper) << "\n";
+  key3("lower", c.rls.lower);
+  key3("upper", c.rls.upper);
   o << "trace_max = " << num(c.rls.trace_max) << "\n";
   o << "forgetting = \"" << (c.rls.forgetting == Forgetting::directional ? "directional" : "exponential") << "\"\n\n";
   o << "[noise]\n";
