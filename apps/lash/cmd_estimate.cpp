@@ -22,22 +22,28 @@ namespace {
 
 nlohmann::ordered_json num(double x) { return std::isfinite(x) ? nlohmann::ordered_json(x) : nlohmann::ordered_json(); }
 
-nlohmann::ordered_json side_json(const EstimateReport& r, const SideReport& s, const GuessReport& g) {
-  nlohmann::ordered_json j;
+/// One side's (linear: the model's) keys: a1, b1, c, d, identified, updates as before, plus
+/// the verdict's reason (null when identified), K and tau_s.
+void put_side(nlohmann::ordered_json& j, const EstimateReport& r, const SideReport& s, const GuessReport& g) {
   j["a1"] = num(s.params.a1);
   j["b1"] = num(s.params.b1);
   if (r.has_c) j["c"] = num(s.params.c);
   if (r.has_side_d) j["d"] = num(s.params.d);
   j["identified"] = s.params.identified;
+  nlohmann::ordered_json u = nlohmann::ordered_json::object();
+  for (const auto& [k, n] : s.updates) u[k] = n;
+  j["updates"] = u;
+  j["reason"] = s.params.identified ? nlohmann::ordered_json() : nlohmann::ordered_json(to_string(s.params.reason));
+  j["K"] = num(s.K);
+  j["tau_s"] = num(s.tau_s);
   if (g.source != GuessSource::unused) {
     if (g.wrong_side) j["reason"] = "wrong_guess";
     j["guess"] = {{"value", num(g.guess)}, {"source", to_string(g.source)}, {"edge_seen", num(g.edge)}};
   }
-  nlohmann::ordered_json u = nlohmann::ordered_json::object();
-  for (const auto& [k, n] : s.updates) u[k] = n;
-  j["updates"] = u;
-  return j;
 }
+
+/// 6 significant digits for a person ("-" for a missing value).
+std::string sig(double x) { return std::isfinite(x) ? fmt::format("{:.6g}", x) : std::string("-"); }
 
 int run(const EstimateOptions& o) {
   Preset preset{};
@@ -73,7 +79,8 @@ int run(const EstimateOptions& o) {
   (void)assemble(o, model, preset, nullptr, job);
 
   const Record rec = load_record(o.data, job.columns);
-  const EstimatorConfig cfg = assemble(o, model, preset, &rec, job);
+  EstimatorConfig cfg = assemble(o, model, preset, &rec, job);
+  cfg.fit_start_s = job.nrmse_t0_s;  // the verdict's fit window starts where the reported NRMSE's does
   const bool keep = !o.out.empty() || !o.plot.empty();
   const auto t_start = std::chrono::steady_clock::now();
   const AutoRun ar = estimate_auto(cfg, rec.v(), rec.y(), keep, o.outlier_gate);
@@ -131,41 +138,38 @@ int run(const EstimateOptions& o) {
     j["model"] = to_string(r.model);
     j["samples"] = r.samples;
     if (r.model == ModelKind::linear) {
-      j["a1"] = num(r.right.params.a1);
-      j["b1"] = num(r.right.params.b1);
-      j["identified"] = r.right.params.identified;
-      nlohmann::ordered_json u = nlohmann::ordered_json::object();
-      for (const auto& [k, n] : r.right.updates) u[k] = n;
-      j["updates"] = u;
+      put_side(j, r, r.right, ar.right);
     } else {
-      j["right"] = side_json(r, r.right, ar.right);
-      j["left"] = side_json(r, r.left, ar.left);
+      put_side(j["right"], r, r.right, ar.right);
+      put_side(j["left"], r, r.left, ar.left);
     }
     if (r.has_shared_d) {
       j["d"] = num(r.d);
       nlohmann::ordered_json u = nlohmann::ordered_json::object();
       for (const auto& [k, n] : r.d_updates) u[k] = n;
       j["d_updates"] = u;
+      j["d_reason"] = r.d_reason == Reason::none ? nlohmann::ordered_json() : nlohmann::ordered_json(to_string(r.d_reason));
     }
     j["outliers"] = ar.outliers;
     j["preset"] = to_string(preset);
     j["nrmse"] = num(fit);
+    j["nrmse_pct"] = num(100.0 * fit);
     j["nrmse_window_s"] = {job.nrmse_t0_s, t1};
     fmt::print("{}\n", j.dump());
   } else {
     fmt::print("model {}: {} samples at dt = {} s, {} skipped\n", to_string(r.model), r.samples,
                format_double(rec.dt_s), r.skipped);
     auto show = [&](const char* name, const SideReport& s, const GuessReport& g) {
-      std::string line = fmt::format("{:>6}: a1 = {}  b1 = {}", name, format_double(s.params.a1),
-                                     format_double(s.params.b1));
-      if (r.has_c) line += "  c = " + format_double(s.params.c);
-      if (r.has_side_d) line += "  d = " + format_double(s.params.d);
-      line += s.params.identified ? "  identified" : "  NOT identified";
+      std::string line = fmt::format("{:>6}: a1 = {}  b1 = {}", name, sig(s.params.a1), sig(s.params.b1));
+      if (r.has_c) line += "  c = " + sig(s.params.c);
+      if (r.has_side_d) line += "  d = " + sig(s.params.d);
+      line += "  K = " + sig(s.K) + "  tau = " + sig(s.tau_s) + " s";
+      line += s.params.identified ? "  identified" : fmt::format("  NOT identified ({})", to_string(s.params.reason));
       if (g.wrong_side)
-        line += fmt::format(" (wrong_guess: the {} guess {} lies inside the deadzone, edge seen at {})", name,
-                            format_double(g.guess), format_double(g.edge));
+        line += fmt::format(" wrong_guess: the {} guess {} lies inside the deadzone (edge seen at {})", name,
+                            sig(g.guess), sig(g.edge));
       else if (g.source != GuessSource::unused)
-        line += fmt::format("  guess {} ({})", format_double(g.guess), to_string(g.source));
+        line += fmt::format("  guess {} ({})", sig(g.guess), to_string(g.source));
       line += "  updates";
       for (const auto& [k, n] : s.updates) line += fmt::format(" {}:{}", k, n);
       fmt::print("{}\n", line);
@@ -176,10 +180,10 @@ int run(const EstimateOptions& o) {
       show("left", r.left, ar.left);
     }
     if (ar.outliers > 0) fmt::print("outliers: {} samples of y replaced by the outlier gate\n", ar.outliers);
-    if (r.has_shared_d) fmt::print("     d = {} (updates +:{} -:{})\n", format_double(r.d), r.d_updates[0].second,
-                                   r.d_updates[1].second);
-    fmt::print("NRMSE of the simulated output over [{}, {}] s: {}\n", format_double(job.nrmse_t0_s),
-               format_double(t1), format_double(fit));
+    if (r.has_shared_d) fmt::print("     d = {} (updates +:{} -:{}){}\n", sig(r.d), r.d_updates[0].second,
+                                   r.d_updates[1].second,
+                                   r.d_reason == Reason::none ? "" : fmt::format("  NOT identified ({})", to_string(r.d_reason)));
+    fmt::print("NRMSE of the simulated output over [{}, {}] s: {} %\n", sig(job.nrmse_t0_s), sig(t1), sig(100.0 * fit));
   }
   return kExitOk;
 }
