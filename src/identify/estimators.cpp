@@ -46,8 +46,10 @@ double LinearEstimator::step(double v, double y) noexcept {
     yhat_ = rls_.update_iv(phi, {-hist_.ago(1 + cfg_.iv_delay), v1_}, s.y);
   else
     yhat_ = rls_.update(phi, s.y);
-  vrange_.add(v1_);
-  yrange_.add(y1_);
+  if (rls_.updates() > 1) {  // the first update's regressors are the zero initial state, not data
+    vrange_.add(v1_);
+    yrange_.add(y1_);
+  }
   hist_.push(s.y);
   y1_ = s.y;
   v1_ = s.v;
