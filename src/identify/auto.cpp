@@ -111,11 +111,10 @@ EstimatorConfig preset_config(ModelKind model, Preset preset, double dt_s) {
       c.rls.upper = {0.0, kInf, kInf};
       break;
     case ModelKind::output_deadzone:
-      // E3 (lash settings): directional forgetting, MA10 on v and y; λ from the data.
+      // E3 (lash settings): directional forgetting; λ from the sample time. No moving average: its
+      // start-up ramp would make a constant input look excited (the verdict reads v over the updates).
       c.rls.lambda = 0.9995;
       c.rls.forgetting = Forgetting::directional;
-      c.noise.filter_length = 10;
-      c.noise.filter_input = true;
       break;
     case ModelKind::linear:
       c.rls.lambda = 0.9995;
