@@ -14,6 +14,7 @@
 #include "estimate_settings.hpp"
 #include "lash/identify/any_estimator.hpp"
 #include "lash/identify/auto.hpp"
+#include "lash/identify/estimate_report.hpp"
 #include "lash/identify/config_file.hpp"
 #include "lash/identify/data.hpp"
 
@@ -22,28 +23,12 @@ namespace {
 
 nlohmann::ordered_json num(double x) { return std::isfinite(x) ? nlohmann::ordered_json(x) : nlohmann::ordered_json(); }
 
-/// One side's (linear: the model's) keys: a1, b1, c, d, identified, updates as before, plus
-/// the verdict's reason (null when identified), K and tau_s.
-void put_side(nlohmann::ordered_json& j, const EstimateReport& r, const SideReport& s, const GuessReport& g) {
-  j["a1"] = num(s.params.a1);
-  j["b1"] = num(s.params.b1);
-  if (r.has_c) j["c"] = num(s.params.c);
-  if (r.has_side_d) j["d"] = num(s.params.d);
-  j["identified"] = s.params.identified;
-  nlohmann::ordered_json u = nlohmann::ordered_json::object();
-  for (const auto& [k, n] : s.updates) u[k] = n;
-  j["updates"] = u;
-  j["reason"] = s.params.identified ? nlohmann::ordered_json() : nlohmann::ordered_json(to_string(s.params.reason));
-  j["K"] = num(s.K);
-  j["tau_s"] = num(s.tau_s);
-  if (g.source != GuessSource::unused) {
-    if (g.wrong_side) j["reason"] = "wrong_guess";
-    j["guess"] = {{"value", num(g.guess)}, {"source", to_string(g.source)}, {"edge_seen", num(g.edge)}};
-  }
+/// What estimate_auto adds to a side: the guess it used, and wrong_guess when it lay inside the deadzone.
+void put_guess(nlohmann::ordered_json& j, const GuessReport& g) {
+  if (g.source == GuessSource::unused) return;
+  if (g.wrong_side) j["reason"] = "wrong_guess";
+  j["guess"] = {{"value", num(g.guess)}, {"source", to_string(g.source)}, {"edge_seen", num(g.edge)}};
 }
-
-/// 6 significant digits for a person ("-" for a missing value).
-std::string sig(double x) { return std::isfinite(x) ? fmt::format("{:.6g}", x) : std::string("-"); }
 
 int run(const EstimateOptions& o) {
   Preset preset{};
@@ -83,12 +68,13 @@ int run(const EstimateOptions& o) {
   cfg.fit_start_s = job.nrmse_t0_s;  // the verdict's fit window starts where the reported NRMSE's does
   const bool keep = !o.out.empty() || !o.plot.empty();
   const auto t_start = std::chrono::steady_clock::now();
-  const AutoRun ar = estimate_auto(cfg, rec.v(), rec.y(), keep, o.outlier_gate);
-  const EstimationRun& run = ar.run;
+  AutoRun ar = estimate_auto(cfg, rec.v(), rec.y(), keep, o.outlier_gate);
+  EstimationRun& run = ar.run;
   const double elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   if (o.timing)
     fmt::print(stderr, "lash estimate: estimator ran {} samples in {} s ({:.3g} M samples/s)\n", rec.v().size(),
                format_double(elapsed_s), static_cast<double>(rec.v().size()) / elapsed_s * 1e-6);
+  add_intervals(run, ar.cfg, rec.v(), rec.y());
   const auto& t = rec.t();
   const double t1 = job.nrmse_t1_s < 0 ? t.back() : job.nrmse_t1_s;
   const double fit = nrmse(t, rec.y(), run.ysim, job.nrmse_t0_s, t1);
@@ -132,58 +118,24 @@ int run(const EstimateOptions& o) {
     if (!tmp.empty()) std::filesystem::remove(tmp);
   }
 
-  const EstimateReport& r = run.report;
+  const ReportFit rf{fit, job.nrmse_t0_s, t1};
   if (o.json) {
-    nlohmann::ordered_json j;
-    j["model"] = to_string(r.model);
-    j["samples"] = r.samples;
-    if (r.model == ModelKind::linear) {
-      put_side(j, r, r.right, ar.right);
-    } else {
-      put_side(j["right"], r, r.right, ar.right);
-      put_side(j["left"], r, r.left, ar.left);
-    }
-    if (r.has_shared_d) {
-      j["d"] = num(r.d);
-      nlohmann::ordered_json u = nlohmann::ordered_json::object();
-      for (const auto& [k, n] : r.d_updates) u[k] = n;
-      j["d_updates"] = u;
-      j["d_reason"] = r.d_reason == Reason::none ? nlohmann::ordered_json() : nlohmann::ordered_json(to_string(r.d_reason));
-    }
+    auto j = nlohmann::ordered_json::parse(estimate_json(run.report, rf));
+    if (j.contains("right")) put_guess(j["right"], ar.right);
+    if (j.contains("left")) put_guess(j["left"], ar.left);
     j["outliers"] = ar.outliers;
     j["preset"] = to_string(preset);
-    j["nrmse"] = num(fit);
-    j["nrmse_pct"] = num(100.0 * fit);
-    j["nrmse_window_s"] = {job.nrmse_t0_s, t1};
     fmt::print("{}\n", j.dump());
   } else {
-    fmt::print("model {}: {} samples at dt = {} s, {} skipped\n", to_string(r.model), r.samples,
-               format_double(rec.dt_s), r.skipped);
-    auto show = [&](const char* name, const SideReport& s, const GuessReport& g) {
-      std::string line = fmt::format("{:>6}: a1 = {}  b1 = {}", name, sig(s.params.a1), sig(s.params.b1));
-      if (r.has_c) line += "  c = " + sig(s.params.c);
-      if (r.has_side_d) line += "  d = " + sig(s.params.d);
-      line += "  K = " + sig(s.K) + "  tau = " + sig(s.tau_s) + " s";
-      line += s.params.identified ? "  identified" : fmt::format("  NOT identified ({})", to_string(s.params.reason));
+    fmt::print("{}", estimate_text(run.report, rec.dt_s, rf));
+    for (const auto& [name, g] : {std::pair{"right", ar.right}, std::pair{"left", ar.left}}) {
       if (g.wrong_side)
-        line += fmt::format(" wrong_guess: the {} guess {} lies inside the deadzone (edge seen at {})", name,
-                            sig(g.guess), sig(g.edge));
+        fmt::print("wrong_guess: the {} guess {:.6g} lies inside the deadzone (edge seen at {:.6g})\n", name, g.guess,
+                   g.edge);
       else if (g.source != GuessSource::unused)
-        line += fmt::format("  guess {} ({})", sig(g.guess), to_string(g.source));
-      line += "  updates";
-      for (const auto& [k, n] : s.updates) line += fmt::format(" {}:{}", k, n);
-      fmt::print("{}\n", line);
-    };
-    if (r.model == ModelKind::linear) show("model", r.right, ar.right);
-    else {
-      show("right", r.right, ar.right);
-      show("left", r.left, ar.left);
+        fmt::print("{} guess: {:.6g} ({})\n", name, g.guess, to_string(g.source));
     }
     if (ar.outliers > 0) fmt::print("outliers: {} samples of y replaced by the outlier gate\n", ar.outliers);
-    if (r.has_shared_d) fmt::print("     d = {} (updates +:{} -:{}){}\n", sig(r.d), r.d_updates[0].second,
-                                   r.d_updates[1].second,
-                                   r.d_reason == Reason::none ? "" : fmt::format("  NOT identified ({})", to_string(r.d_reason)));
-    fmt::print("NRMSE of the simulated output over [{}, {}] s: {} %\n", sig(job.nrmse_t0_s), sig(t1), sig(100.0 * fit));
   }
   return kExitOk;
 }
