@@ -1,4 +1,4 @@
-#include "lash/sweep/sweep.hpp"
+#include "lash/experiments/sweep.hpp"
 
 #include <algorithm>
 #include <atomic>

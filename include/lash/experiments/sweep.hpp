@@ -14,7 +14,7 @@
 
 #include "lash/blocks/side.hpp"
 #include "lash/identify/estimators.hpp"
-#include "lash/sweep/campaign.hpp"
+#include "lash/experiments/campaign.hpp"
 
 namespace lash::sweep {
 

@@ -1,4 +1,4 @@
-#include "lash/identify/scenario.hpp"
+#include "lash/experiments/scenario.hpp"
 
 #include <algorithm>
 #include <cmath>
