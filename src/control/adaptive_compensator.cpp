@@ -143,8 +143,9 @@ void DeadzoneCompensator::observe(double v_applied, double y) noexcept {
   else if (v1 < cfg_.estimator.guess_left) exc_l_.add(v1);
   const SideParams r = est_.params(Side::right), l = est_.params(Side::left);
   const double ratio = cfg_.adaptation.min_excitation_ratio;
-  const bool ex_r = exc_r_.stddev() >= ratio * cfg_.nominal.offset_right;
-  const bool ex_l = exc_l_.stddev() >= ratio * cfg_.nominal.offset_left;
+  const double need_r = ratio * cfg_.nominal.offset_right, need_l = ratio * cfg_.nominal.offset_left;
+  const bool ex_r = exc_r_.var >= need_r * need_r;  // std ≥ need, without a square root
+  const bool ex_l = exc_l_.var >= need_l * need_l;
   const double old_r = gate_r_.value(), old_l = gate_l_.value();
   const double cr = gate_r_.step(r.identified && ex_r, r.c);
   const double cl = gate_l_.step(l.identified && ex_l, -l.c);
