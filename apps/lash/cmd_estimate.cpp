@@ -53,8 +53,9 @@ std::vector<std::string> split_names(const std::string& text) {
 
 nlohmann::ordered_json num(double x) { return std::isfinite(x) ? nlohmann::ordered_json(x) : nlohmann::ordered_json(); }
 
-nlohmann::ordered_json side_json(const EstimateReport& r, const SideReport& s) {
-  nlohmann::ordered_json j;
+/// One side's (linear: the model's) keys: a1, b1, c, d, identified, updates as before, plus
+/// the verdict's reason (null when identified), K and tau_s.
+void put_side(nlohmann::ordered_json& j, const EstimateReport& r, const SideReport& s) {
   j["a1"] = num(s.params.a1);
   j["b1"] = num(s.params.b1);
   if (r.has_c) j["c"] = num(s.params.c);
@@ -63,8 +64,13 @@ nlohmann::ordered_json side_json(const EstimateReport& r, const SideReport& s) {
   nlohmann::ordered_json u = nlohmann::ordered_json::object();
   for (const auto& [k, n] : s.updates) u[k] = n;
   j["updates"] = u;
-  return j;
+  j["reason"] = s.params.identified ? nlohmann::ordered_json() : nlohmann::ordered_json(to_string(s.params.reason));
+  j["K"] = num(s.K);
+  j["tau_s"] = num(s.tau_s);
 }
+
+/// 6 significant digits for a person ("-" for a missing value).
+std::string sig(double x) { return std::isfinite(x) ? fmt::format("{:.6g}", x) : std::string("-"); }
 
 int run(const EstimateOptions& o) {
   EstimatorConfig cfg;
@@ -130,6 +136,7 @@ int run(const EstimateOptions& o) {
 
   const Record rec = load_record(o.data, job.columns);
   cfg.dt_s = rec.dt_s;
+  cfg.fit_start_s = job.nrmse_t0_s;  // the verdict's fit window starts where the reported NRMSE's does
   const bool keep = !o.out.empty() || !o.plot.empty();
   const auto t_start = std::chrono::steady_clock::now();
   const EstimationRun run = run_estimator(cfg, rec.v(), rec.y(), keep);
@@ -190,34 +197,31 @@ int run(const EstimateOptions& o) {
     j["model"] = to_string(r.model);
     j["samples"] = r.samples;
     if (r.model == ModelKind::linear) {
-      j["a1"] = num(r.right.params.a1);
-      j["b1"] = num(r.right.params.b1);
-      j["identified"] = r.right.params.identified;
-      nlohmann::ordered_json u = nlohmann::ordered_json::object();
-      for (const auto& [k, n] : r.right.updates) u[k] = n;
-      j["updates"] = u;
+      put_side(j, r, r.right);
     } else {
-      j["right"] = side_json(r, r.right);
-      j["left"] = side_json(r, r.left);
+      put_side(j["right"], r, r.right);
+      put_side(j["left"], r, r.left);
     }
     if (r.has_shared_d) {
       j["d"] = num(r.d);
       nlohmann::ordered_json u = nlohmann::ordered_json::object();
       for (const auto& [k, n] : r.d_updates) u[k] = n;
       j["d_updates"] = u;
+      j["d_reason"] = r.d_reason == Reason::none ? nlohmann::ordered_json() : nlohmann::ordered_json(to_string(r.d_reason));
     }
     j["nrmse"] = num(fit);
+    j["nrmse_pct"] = num(100.0 * fit);
     j["nrmse_window_s"] = {job.nrmse_t0_s, t1};
     fmt::print("{}\n", j.dump());
   } else {
     fmt::print("model {}: {} samples at dt = {} s, {} skipped\n", to_string(r.model), r.samples,
                format_double(rec.dt_s), r.skipped);
     auto show = [&](const char* name, const SideReport& s) {
-      std::string line = fmt::format("{:>6}: a1 = {}  b1 = {}", name, format_double(s.params.a1),
-                                     format_double(s.params.b1));
-      if (r.has_c) line += "  c = " + format_double(s.params.c);
-      if (r.has_side_d) line += "  d = " + format_double(s.params.d);
-      line += s.params.identified ? "  identified" : "  NOT identified";
+      std::string line = fmt::format("{:>6}: a1 = {}  b1 = {}", name, sig(s.params.a1), sig(s.params.b1));
+      if (r.has_c) line += "  c = " + sig(s.params.c);
+      if (r.has_side_d) line += "  d = " + sig(s.params.d);
+      line += "  K = " + sig(s.K) + "  tau = " + sig(s.tau_s) + " s";
+      line += s.params.identified ? "  identified" : fmt::format("  NOT identified ({})", to_string(s.params.reason));
       line += "  updates";
       for (const auto& [k, n] : s.updates) line += fmt::format(" {}:{}", k, n);
       fmt::print("{}\n", line);
@@ -227,10 +231,10 @@ int run(const EstimateOptions& o) {
       show("right", r.right);
       show("left", r.left);
     }
-    if (r.has_shared_d) fmt::print("     d = {} (updates +:{} -:{})\n", format_double(r.d), r.d_updates[0].second,
-                                   r.d_updates[1].second);
-    fmt::print("NRMSE of the simulated output over [{}, {}] s: {}\n", format_double(job.nrmse_t0_s),
-               format_double(t1), format_double(fit));
+    if (r.has_shared_d) fmt::print("     d = {} (updates +:{} -:{}){}\n", sig(r.d), r.d_updates[0].second,
+                                   r.d_updates[1].second,
+                                   r.d_reason == Reason::none ? "" : fmt::format("  NOT identified ({})", to_string(r.d_reason)));
+    fmt::print("NRMSE of the simulated output over [{}, {}] s: {} %\n", sig(job.nrmse_t0_s), sig(t1), sig(100.0 * fit));
   }
   return kExitOk;
 }
