@@ -167,15 +167,20 @@ AdaptationReason DeadzoneCompensator::reason() const noexcept {
 }
 
 const char* DeadzoneCompensator::estimator_reason(Side s) const noexcept {
-  const SideParams p = est_.params(s);
-  const std::uint64_t n = est_.updates(s);
   if (cfg_.mode != CompensationMode::adaptive) return "no estimator (compensation is not adaptive)";
-  if (n == 0) return "no updates: the command never went beyond this side's guess";
-  if (n < cfg_.estimator.min_updates) return "fewer updates than min_updates";
-  if (!p.identified) return "not identified: unstable model (|a1| >= 1) or edge outside the guesses";
+  // The estimator's update-time verdict (identify/verdict.hpp, checks 1-5), then the compensator's own check.
+  switch (est_.params(s).reason) {
+    case Reason::none: break;
+    case Reason::not_updated: return "not_updated: too few samples beyond this side's guess (min_updates)";
+    case Reason::not_excited: return "not_excited: v(k-1) or y(k-1) took a single value on this side's updates";
+    case Reason::unstable: return "unstable: |a1| >= 1 or not finite";
+    case Reason::unphysical: return "unphysical: b1 <= 0 or the edge on the wrong side of zero";
+    case Reason::poor_fit: return "poor_fit: the free run does not fit";
+    case Reason::wrong_guess: return "wrong_guess: the edge lies outside this side's guess";
+  }
   if (s == Side::right ? not_excited_r_ : not_excited_l_)
-    return "identified, but the command hardly varied on this side (below min_excitation_ratio x nominal): "
-           "b1 and the offset are not separable; turn the dither on";
+    return "identified by the estimator, but v hardly varied on this side (std below min_excitation_ratio x "
+           "nominal): b1 and the offset are not separable; turn the dither on";
   return "identified";
 }
 

@@ -3,8 +3,11 @@
 /// Adaptive inverses: an online estimator of SPEC A4 runs inside the controller at the sample
 /// rate on closed-loop data, and its parameters reach the inverse only through safeguards
 /// (docs/compensation.md):
-///  - **verdict**: a side's estimate is used only while the estimator says that side is
-///    identified, and only if it lies within [min_ratio, max_ratio] × the nominal value;
+///  - **verdict**: a side's estimate is used only while the estimator's verdict says that side
+///    is identified (`params(s).identified`, the update-time checks 1–5 of identify/verdict.hpp:
+///    updated, excited, stable, physical, edge inside the guesses), while the command varied
+///    enough on that side (min_excitation_ratio), and only if it lies within
+///    [min_ratio, max_ratio] × the nominal value;
 ///  - **settle**: the verdict must have held for `settle_s` before its values are used;
 ///  - **dead band**: the inverse starts to move only when the estimate differs from it by
 ///    more than `tolerance_ratio` × nominal (then it follows until it has caught up);
@@ -155,7 +158,8 @@ class DeadzoneCompensator {
   std::uint64_t updates() const noexcept { return updates_; }
   /// The worse of the two sides' reasons (adapting only when both adapt).
   AdaptationReason reason() const noexcept;
-  /// Why the estimator does not identify a side (a fixed text, no allocation).
+  /// Why a side is not used: the estimator's verdict reason (identify/verdict.hpp) or the
+  /// compensator's excitation check (a fixed text, no allocation).
   const char* estimator_reason(Side s) const noexcept;
   const DeadzoneCompensationConfig& config() const noexcept { return cfg_; }
 
