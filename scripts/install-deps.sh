@@ -15,7 +15,7 @@ packages=(
   iproute2 util-linux
   # python oracles (Debian's /usr/bin/python3)
   python3 python3-numpy python3-scipy python3-statsmodels python3-can
-  python3-canmatrix python3-msgpack
+  python3-canmatrix python3-msgpack python3-crcmod
   # SocketCAN test under qemu
   qemu-system-x86 busybox-static cpio
   # libFuzzer / sanitizers runtime for clang
