@@ -7,13 +7,13 @@
 #include <unistd.h>
 
 #include <fmt/core.h>
-#include <nlohmann/json.hpp>
 
 #include "cli_common.hpp"
 #include "plot.hpp"
 #include "lash/identify/any_estimator.hpp"
 #include "lash/identify/config_file.hpp"
 #include "lash/identify/data.hpp"
+#include "lash/identify/estimate.hpp"
 
 namespace lash::cli {
 namespace {
@@ -49,21 +49,6 @@ std::vector<std::string> split_names(const std::string& text) {
     if (n.empty()) throw InputError("", 0, "--columns", "empty column name in '" + text + "'");
   if (out.size() != 3) throw InputError("", 0, "--columns", "expected three names t,v,y, got '" + text + "'");
   return out;
-}
-
-nlohmann::ordered_json num(double x) { return std::isfinite(x) ? nlohmann::ordered_json(x) : nlohmann::ordered_json(); }
-
-nlohmann::ordered_json side_json(const EstimateReport& r, const SideReport& s) {
-  nlohmann::ordered_json j;
-  j["a1"] = num(s.params.a1);
-  j["b1"] = num(s.params.b1);
-  if (r.has_c) j["c"] = num(s.params.c);
-  if (r.has_side_d) j["d"] = num(s.params.d);
-  j["identified"] = s.params.identified;
-  nlohmann::ordered_json u = nlohmann::ordered_json::object();
-  for (const auto& [k, n] : s.updates) u[k] = n;
-  j["updates"] = u;
-  return j;
 }
 
 int run(const EstimateOptions& o) {
@@ -138,8 +123,9 @@ int run(const EstimateOptions& o) {
     fmt::print(stderr, "lash estimate: estimator ran {} samples in {} s ({:.3g} M samples/s)\n", rec.v().size(),
                format_double(elapsed_s), static_cast<double>(rec.v().size()) / elapsed_s * 1e-6);
   const auto& t = rec.t();
-  const double t1 = job.nrmse_t1_s < 0 ? t.back() : job.nrmse_t1_s;
-  const double fit = nrmse(t, rec.y(), run.ysim, job.nrmse_t0_s, t1);
+  const EstimateResult res = score_estimate(run.report, rec.dt_s, job, t, rec.y(), run.ysim);
+  const double t1 = res.nrmse_t1_s;
+  const double fit = res.nrmse;
 
   if (!o.out.empty()) {
     std::vector<std::string> names{"t", "y", "yhat", "y_sim"};
@@ -186,29 +172,7 @@ int run(const EstimateOptions& o) {
 
   const EstimateReport& r = run.report;
   if (o.json) {
-    nlohmann::ordered_json j;
-    j["model"] = to_string(r.model);
-    j["samples"] = r.samples;
-    if (r.model == ModelKind::linear) {
-      j["a1"] = num(r.right.params.a1);
-      j["b1"] = num(r.right.params.b1);
-      j["identified"] = r.right.params.identified;
-      nlohmann::ordered_json u = nlohmann::ordered_json::object();
-      for (const auto& [k, n] : r.right.updates) u[k] = n;
-      j["updates"] = u;
-    } else {
-      j["right"] = side_json(r, r.right);
-      j["left"] = side_json(r, r.left);
-    }
-    if (r.has_shared_d) {
-      j["d"] = num(r.d);
-      nlohmann::ordered_json u = nlohmann::ordered_json::object();
-      for (const auto& [k, n] : r.d_updates) u[k] = n;
-      j["d_updates"] = u;
-    }
-    j["nrmse"] = num(fit);
-    j["nrmse_window_s"] = {job.nrmse_t0_s, t1};
-    fmt::print("{}\n", j.dump());
+    fmt::print("{}\n", to_json(res));
   } else {
     fmt::print("model {}: {} samples at dt = {} s, {} skipped\n", to_string(r.model), r.samples,
                format_double(rec.dt_s), r.skipped);

@@ -1,0 +1,37 @@
+#pragma once
+/// @file estimate.hpp
+/// One estimation over a whole record, as `lash estimate` and Python's `lash.estimate` do it:
+/// the sample period from t, the estimator run, the NRMSE score and the JSON result object.
+/// One implementation, so the CLI's `--json` and Python's `Result.to_dict()` cannot drift apart.
+/// Not real-time safe (allocates). Errors are lash::InputError naming file, line and column.
+#include <span>
+#include <string>
+#include <vector>
+
+#include "lash/identify/any_estimator.hpp"
+#include "lash/identify/config_file.hpp"
+
+namespace lash {
+
+/// What `lash estimate` reports about one record.
+struct EstimateResult {
+  EstimateReport report;
+  double dt_s = 0.0;        ///< sample period used by the estimator (mean step of t) [s]
+  double nrmse = 0.0;       ///< NRMSE of the free-run simulation over the window (SPEC A6); NaN if empty
+  double nrmse_t0_s = 0.0;  ///< window start [s]
+  double nrmse_t1_s = 0.0;  ///< window end [s] (the last t when the job leaves it open)
+};
+
+/// Checks a time column (at least 3 samples, strictly increasing) and returns its mean step [s].
+/// Errors name `file`, the line of the row (from `line_of_row`, when given) and the column `t_name`.
+double sample_period(std::span<const double> t, const std::string& file = "", const std::vector<int>& line_of_row = {},
+                     const std::string& t_name = "t");
+
+/// Scores a finished run: the NRMSE window of `job` over t, y and the simulated output.
+EstimateResult score_estimate(const EstimateReport& report, double dt_s, const EstimationJob& job,
+                              std::span<const double> t, std::span<const double> y, std::span<const double> ysim);
+
+/// The JSON object printed by `lash estimate --json` (one line, no newline). Non-finite numbers are null.
+std::string to_json(const EstimateResult& result);
+
+}  // namespace lash
