@@ -4,8 +4,8 @@
 
 #include <string>
 
-#include "lash/sweep/campaign.hpp"
-#include "lash/sweep/sweep.hpp"
+#include "lash/experiments/campaign.hpp"
+#include "lash/experiments/sweep.hpp"
 
 namespace {
 

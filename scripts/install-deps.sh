@@ -9,7 +9,7 @@ packages=(
   build-essential cmake ninja-build g++ clang pkg-config
   # libraries
   libeigen3-dev libcli11-dev libfmt-dev libtomlplusplus-dev nlohmann-json3-dev
-  libmatio-dev
+  libmatio-dev zlib1g-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev gnuplot-nox valgrind
   iproute2 util-linux

@@ -9,7 +9,7 @@
 #include "plot.hpp"
 #include "lash/plant/plant_file.hpp"
 #include "lash/plant/simulate.hpp"
-#include "lash/identify/scenario.hpp"
+#include "lash/experiments/scenario.hpp"
 
 namespace lash::cli {
 namespace {

@@ -51,6 +51,9 @@ std::vector<std::string> split_names(const std::string& text) {
   return out;
 }
 
+/// 6 significant digits for a person ("-" for a missing value).
+std::string sig(double x) { return std::isfinite(x) ? fmt::format("{:.6g}", x) : std::string("-"); }
+
 int run(const EstimateOptions& o) {
   EstimatorConfig cfg;
   EstimationJob job;
@@ -114,7 +117,7 @@ int run(const EstimateOptions& o) {
   }
 
   const Record rec = load_record(o.data, job.columns);
-  cfg.dt_s = rec.dt_s;
+  cfg = config_for_record(cfg, job, rec.dt_s);  // the verdict's fit window starts where the NRMSE's does
   const bool keep = !o.out.empty() || !o.plot.empty();
   const auto t_start = std::chrono::steady_clock::now();
   const EstimationRun run = run_estimator(cfg, rec.v(), rec.y(), keep);
@@ -177,11 +180,11 @@ int run(const EstimateOptions& o) {
     fmt::print("model {}: {} samples at dt = {} s, {} skipped\n", to_string(r.model), r.samples,
                format_double(rec.dt_s), r.skipped);
     auto show = [&](const char* name, const SideReport& s) {
-      std::string line = fmt::format("{:>6}: a1 = {}  b1 = {}", name, format_double(s.params.a1),
-                                     format_double(s.params.b1));
-      if (r.has_c) line += "  c = " + format_double(s.params.c);
-      if (r.has_side_d) line += "  d = " + format_double(s.params.d);
-      line += s.params.identified ? "  identified" : "  NOT identified";
+      std::string line = fmt::format("{:>6}: a1 = {}  b1 = {}", name, sig(s.params.a1), sig(s.params.b1));
+      if (r.has_c) line += "  c = " + sig(s.params.c);
+      if (r.has_side_d) line += "  d = " + sig(s.params.d);
+      line += "  K = " + sig(s.K) + "  tau = " + sig(s.tau_s) + " s";
+      line += s.params.identified ? "  identified" : fmt::format("  NOT identified ({})", to_string(s.params.reason));
       line += "  updates";
       for (const auto& [k, n] : s.updates) line += fmt::format(" {}:{}", k, n);
       fmt::print("{}\n", line);
@@ -191,10 +194,10 @@ int run(const EstimateOptions& o) {
       show("right", r.right);
       show("left", r.left);
     }
-    if (r.has_shared_d) fmt::print("     d = {} (updates +:{} -:{})\n", format_double(r.d), r.d_updates[0].second,
-                                   r.d_updates[1].second);
-    fmt::print("NRMSE of the simulated output over [{}, {}] s: {}\n", format_double(job.nrmse_t0_s),
-               format_double(t1), format_double(fit));
+    if (r.has_shared_d) fmt::print("     d = {} (updates +:{} -:{}){}\n", sig(r.d), r.d_updates[0].second,
+                                   r.d_updates[1].second,
+                                   r.d_reason == Reason::none ? "" : fmt::format("  NOT identified ({})", to_string(r.d_reason)));
+    fmt::print("NRMSE of the simulated output over [{}, {}] s: {} %\n", sig(job.nrmse_t0_s), sig(t1), sig(100.0 * fit));
   }
   return kExitOk;
 }

@@ -11,8 +11,8 @@
 
 #include "cli_common.hpp"
 #include "plot.hpp"
-#include "lash/sweep/campaign.hpp"
-#include "lash/sweep/sweep.hpp"
+#include "lash/experiments/campaign.hpp"
+#include "lash/experiments/sweep.hpp"
 
 namespace lash::cli {
 namespace {

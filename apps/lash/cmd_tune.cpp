@@ -4,7 +4,7 @@
 
 #include "cli_common.hpp"
 #include "lash/control/gains_file.hpp"
-#include "lash/control/tune.hpp"
+#include "lash/experiments/tune.hpp"
 
 namespace lash::cli {
 namespace {

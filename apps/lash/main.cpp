@@ -2,11 +2,9 @@
 #include <CLI/CLI.hpp>
 
 #include "cli_common.hpp"
-#include "lash/io/mat.hpp"
 
 int main(int argc, char** argv) {
   using namespace lash::cli;
-  lash::register_mat_reader();  // .mat records for every command that reads columns
   CLI::App app{"lash: identify deadzones and backlash online, simulate such plants, emulate ECUs over CAN"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "lash 0.1.0");

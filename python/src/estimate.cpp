@@ -25,8 +25,8 @@ void configure(EstimatorConfig& cfg, EstimationJob& job, const std::string& mode
   read_estimator_config(t, cfg, &job);
 }
 
-void validate(EstimatorConfig& cfg, double dt_s) {
-  cfg.dt_s = dt_s;
+void validate(EstimatorConfig& cfg, const EstimationJob& job, double dt_s) {
+  cfg = config_for_record(cfg, job, dt_s);
   try {
     cfg.validate();
   } catch (const std::invalid_argument& e) {
@@ -48,7 +48,7 @@ class Estimator {
   Estimator(const std::string& model, double dt_s, const pyb::kwargs& settings) {
     configure(cfg_, job_, model, settings);
     if (!(dt_s > 0) || !std::isfinite(dt_s)) throw InputError("", 0, "dt", "must be a finite number > 0 [s]");
-    validate(cfg_, dt_s);
+    validate(cfg_, job_, dt_s);
     est_ = std::make_unique<AnyEstimator>(cfg_);
   }
 
@@ -139,7 +139,7 @@ Result estimate(const pyb::handle& t_obj, const pyb::handle& v_obj, const pyb::h
   if (y.size() != t.size())
     throw InputError("", 0, "y", "has " + std::to_string(y.size()) + " samples, t has " + std::to_string(t.size()));
   const double dt = sample_period(t, "", {}, "t");
-  validate(cfg, dt);
+  validate(cfg, job, dt);
   std::optional<EstimationRun> run;
   std::optional<EstimateResult> res;
   {

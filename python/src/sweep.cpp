@@ -2,8 +2,8 @@
 #include <optional>
 
 #include "convert.hpp"
-#include "lash/sweep/campaign.hpp"
-#include "lash/sweep/sweep.hpp"
+#include "lash/experiments/campaign.hpp"
+#include "lash/experiments/sweep.hpp"
 
 namespace lash::py {
 

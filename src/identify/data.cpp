@@ -1,52 +1,28 @@
 #include "lash/identify/data.hpp"
 
-#include <algorithm>
-#include <cctype>
-#include <map>
-#include <mutex>
-
 #include "lash/identify/estimate.hpp"
 #include "lash/io/csv.hpp"
 #include "lash/io/error.hpp"
+#include "lash/io/mat.hpp"
 
 namespace lash {
 
 namespace {
-std::mutex& registry_mutex() {
-  static std::mutex m;
-  return m;
-}
-std::map<std::string, ColumnReader>& registry() {
-  static std::map<std::string, ColumnReader> r;
-  return r;
-}
-
-ColumnData read_csv_columns(const std::filesystem::path& path, const std::vector<std::string>& names) {
-  CsvTable t = read_csv(path);
+ColumnData to_columns(CsvTable t, const std::vector<std::string>& names) {
   ColumnData d;
-  d.file = t.file;
+  for (const auto& n : names) d.cols.push_back(std::move(t.cols[t.column(n)]));
+  d.file = std::move(t.file);
   d.names = names;
-  for (const auto& n : names) d.cols.push_back(t[n]);
-  d.line_of_row = t.line_of_row;
+  d.line_of_row = std::move(t.line_of_row);
   return d;
 }
 }  // namespace
 
-void register_column_reader(const std::string& extension, ColumnReader reader) {
-  std::lock_guard<std::mutex> lock(registry_mutex());
-  registry()[extension] = std::move(reader);
-}
-
 ColumnData load_columns(const std::filesystem::path& path, const std::vector<std::string>& names) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  ColumnReader reader;
-  {
-    std::lock_guard<std::mutex> lock(registry_mutex());
-    auto it = registry().find(ext);
-    if (it != registry().end()) reader = it->second;
-  }
-  return reader ? reader(path, names) : read_csv_columns(path, names);
+  for (std::size_t i = 0; i < names.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (names[i] == names[j]) throw InputError("", 0, "--columns", "column '" + names[i] + "' is chosen twice");
+  return to_columns(is_mat_file(path) ? read_mat(path, names) : read_csv(path), names);
 }
 
 Record load_record(const std::filesystem::path& path, const std::vector<std::string>& names) {

@@ -18,15 +18,18 @@ nlohmann::ordered_json updates_json(const std::vector<std::pair<std::string, std
   return u;
 }
 
-nlohmann::ordered_json side_json(const EstimateReport& r, const SideReport& s) {
-  nlohmann::ordered_json j;
+/// One side's (linear: the model's) keys: a1, b1, c, d, identified, updates, the verdict's
+/// reason (null when identified), K and tau_s.
+void put_side(nlohmann::ordered_json& j, const EstimateReport& r, const SideReport& s) {
   j["a1"] = num(s.params.a1);
   j["b1"] = num(s.params.b1);
   if (r.has_c) j["c"] = num(s.params.c);
   if (r.has_side_d) j["d"] = num(s.params.d);
   j["identified"] = s.params.identified;
   j["updates"] = updates_json(s.updates);
-  return j;
+  j["reason"] = s.params.identified ? nlohmann::ordered_json() : nlohmann::ordered_json(to_string(s.params.reason));
+  j["K"] = num(s.K);
+  j["tau_s"] = num(s.tau_s);
 }
 }  // namespace
 
@@ -43,6 +46,12 @@ double sample_period(std::span<const double> t, const std::string& file, const s
     }
   }
   return (t.back() - t.front()) / static_cast<double>(t.size() - 1);
+}
+
+EstimatorConfig config_for_record(EstimatorConfig cfg, const EstimationJob& job, double dt_s) {
+  cfg.dt_s = dt_s;
+  cfg.fit_start_s = job.nrmse_t0_s;
+  return cfg;
 }
 
 EstimateResult score_estimate(const EstimateReport& report, double dt_s, const EstimationJob& job,
@@ -62,19 +71,18 @@ std::string to_json(const EstimateResult& res) {
   j["model"] = to_string(r.model);
   j["samples"] = r.samples;
   if (r.model == ModelKind::linear) {
-    j["a1"] = num(r.right.params.a1);
-    j["b1"] = num(r.right.params.b1);
-    j["identified"] = r.right.params.identified;
-    j["updates"] = updates_json(r.right.updates);
+    put_side(j, r, r.right);
   } else {
-    j["right"] = side_json(r, r.right);
-    j["left"] = side_json(r, r.left);
+    put_side(j["right"], r, r.right);
+    put_side(j["left"], r, r.left);
   }
   if (r.has_shared_d) {
     j["d"] = num(r.d);
     j["d_updates"] = updates_json(r.d_updates);
+    j["d_reason"] = r.d_reason == Reason::none ? nlohmann::ordered_json() : nlohmann::ordered_json(to_string(r.d_reason));
   }
   j["nrmse"] = num(res.nrmse);
+  j["nrmse_pct"] = num(100.0 * res.nrmse);
   j["nrmse_window_s"] = {res.nrmse_t0_s, res.nrmse_t1_s};
   return j.dump();
 }

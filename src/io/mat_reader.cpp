@@ -7,7 +7,6 @@
 
 #include <matio.h>
 
-#include "lash/identify/data.hpp"
 #include "lash/io/csv.hpp"
 #include "lash/io/error.hpp"
 #include "lash/io/mat.hpp"
@@ -134,17 +133,6 @@ std::vector<double> read_column(mat_t* mat, const std::string& file, const std::
 }
 
 }  // namespace
-
-void register_mat_reader() {
-  register_column_reader(".mat", [](const std::filesystem::path& path, const std::vector<std::string>& names) {
-    CsvTable t = read_mat(path, names);
-    ColumnData d;
-    d.file = t.file;
-    d.names = std::move(t.header);
-    d.cols = std::move(t.cols);
-    return d;
-  });
-}
 
 bool is_mat_file(const std::filesystem::path& path) {
   std::string ext = path.extension().string();

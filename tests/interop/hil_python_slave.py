@@ -4,6 +4,7 @@ speaks config/hydraulic_bench.dbc through canmatrix — it answers the CCP CONNE
 recorded DTO read by python-can's CanutilsLogReader and sends sensor frames from its own
 simple plant — while `lash hil master` holds a step reference on it. Runs in a private
 network namespace (unshare -n)."""
+import json
 import math
 import os
 import subprocess
@@ -96,37 +97,62 @@ def slave():
         bus.shutdown()
 
 
-th = threading.Thread(target=slave, daemon=True)
-th.start()
-time.sleep(0.5)
-out = tempfile.mkdtemp(prefix="lash_hil_py_")
-r = subprocess.run([hil_netns.lash(), "hil", "master", "--bus", "udp:239.74.163.2:43113", "--duration", "3", "--fifo", "50",
-                    "--reference", "step:from=500,to=1500,time=1", "--log", f"{out}/master.csv",
-                    "--stats", f"{out}/master.json", "--bus-log", f"{out}/master_bus.log"],
-                   capture_output=True, text=True, timeout=60)
-stop.set()
-th.join(2)
-print(r.stderr)
-assert r.returncode == 0, r.stderr
-assert stats["dto"] == 1 and stats["commands"] > 500, stats
+def run_once(attempt):
+    """One master run against the python-can slave; returns (master stats, settling [s], tail, before)."""
+    stop.clear()
+    for k in stats:
+        stats[k] = 0
+    th = threading.Thread(target=slave, daemon=True)
+    th.start()
+    time.sleep(0.5)
+    r = subprocess.run([hil_netns.lash(), "hil", "master", "--bus", "udp:239.74.163.2:43113", "--duration", "3",
+                        "--fifo", "50", "--reference", "step:from=500,to=1500,time=1", "--log", f"{out}/master.csv",
+                        "--stats", f"{out}/master.json", "--bus-log", f"{out}/master_bus.log"],
+                       capture_output=True, text=True, timeout=60)
+    stop.set()
+    th.join(2)
+    print(r.stderr)
+    assert r.returncode == 0, r.stderr
+    assert stats["dto"] == 1 and stats["commands"] > 500, stats
+    with open(f"{out}/master.json") as f:
+        ms = json.load(f)
+    m = hil_netns.read_csv(f"{out}/master.csv")
+    rows = [i for i, cs in enumerate(m["control_step"]) if cs >= 0]
+    t = [m["control_step"][i] * T for i in rows]
+    y = [m["measured_kPa"][i] for i in rows]
+    i_mA = [m["current_mA"][i] for i in rows]
+    assert max(i_mA) <= 2000 and min(i_mA) >= 0
+    # Settling into the 10 % band of the 500 -> 1500 kPa step (thesis simulation: 0.25 s).
+    after = [(tt, yy) for tt, yy in zip(t, y) if tt >= 1.0]
+    outside = [tt for tt, yy in after if abs(yy - 1500) > 100]
+    settling = (max(outside) - 1.0) if outside else 0.0
+    tail = [yy for tt, yy in after if tt >= 2.5]
+    before = [yy for tt, yy in zip(t, y) if 0.7 <= tt < 1.0]
+    late = ms["frames"]["late"] + ms["frames"]["lost"]
+    print(f"attempt {attempt}: python-can slave: settling {settling:.3f} s, final mean {sum(tail) / len(tail):.1f} kPa, "
+          f"{stats['sensors']} sensor frames sent, {late} late or lost at the master")
+    return late, settling, tail, before
 
-m = hil_netns.read_csv(f"{out}/master.csv")
-rows = [i for i, cs in enumerate(m["control_step"]) if cs >= 0]
-t = [m["control_step"][i] * T for i in rows]
-y = [m["measured_kPa"][i] for i in rows]
-i_mA = [m["current_mA"][i] for i in rows]
-assert max(i_mA) <= 2000 and min(i_mA) >= 0
-# Settling into the 10 % band of the 500 -> 1500 kPa step within 0.5 s of the step (thesis
-# simulation: 0.25 s), and then staying there; steady state within 1 % at the end.
-after = [(tt, yy) for tt, yy in zip(t, y) if tt >= 1.0]
-outside = [tt for tt, yy in after if abs(yy - 1500) > 100]
-settling = (max(outside) - 1.0) if outside else 0.0
-tail = [yy for tt, yy in after if tt >= 2.5]
-print(f"python-can slave: settling {settling:.3f} s, final mean {sum(tail) / len(tail):.1f} kPa, "
-      f"{stats['sensors']} sensor frames sent")
+
+out = tempfile.mkdtemp(prefix="lash_hil_py_")
+# The loop's dynamics are lash's only while the python slave keeps its schedule: a sensor frame
+# late at the master is a delay in the loop, and with the thesis's aggressive gains a few dozen
+# of them (a python thread on a loaded host) stretch the settling. So the step-response figures
+# are asserted on a run whose frames were on time (at most 1 % late); every run must pass the
+# interoperability checks above. A host too busy for any such run is a skip, not a pass.
+clean = None
+for attempt in range(1, 4):
+    late, settling, tail, before = run_once(attempt)
+    if late <= 6:
+        clean = (settling, tail, before)
+        break
+if clean is None:
+    print("skip: every attempt had late sensor frames (python slave too slow on this host)")
+    sys.exit(hil_netns.SKIP)
+settling, tail, before = clean
+# Settling within 0.5 s of the step and then staying in the band; steady state within 1 %.
 assert settling <= 0.5, settling
 assert abs(sum(tail) / len(tail) - 1500) < 15
-before = [yy for tt, yy in zip(t, y) if 0.7 <= tt < 1.0]
 assert abs(sum(before) / len(before) - 500) < 10
 # The bus log is a candump -L log python-can can read, and it holds the handshake.
 msgs = list(can.CanutilsLogReader(f"{out}/master_bus.log"))

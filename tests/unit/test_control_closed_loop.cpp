@@ -9,7 +9,7 @@
 #include "lash/control/closed_loop.hpp"
 #include "lash/control/gains_file.hpp"
 #include "lash/control/ode3.hpp"
-#include "lash/control/tune.hpp"
+#include "lash/experiments/tune.hpp"
 #include "lash/io/error.hpp"
 
 namespace {

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <string>
 
-#include "lash/identify/scenario.hpp"
+#include "lash/experiments/scenario.hpp"
 
 namespace lash {
 namespace {

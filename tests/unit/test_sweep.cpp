@@ -5,8 +5,8 @@
 
 #include <gtest/gtest.h>
 
-#include "lash/sweep/campaign.hpp"
-#include "lash/sweep/sweep.hpp"
+#include "lash/experiments/campaign.hpp"
+#include "lash/experiments/sweep.hpp"
 
 using namespace lash::sweep;
 

@@ -8,7 +8,8 @@
 ///                                  RestrictorValve_Cmd [mA], Command_Counter
 ///   BenchSensors (slave → master): PilotPressure_Duty, SupplyPressure_Duty
 ///                                  [uint16 duty code], Sensor_Counter
-///   CCP_CRO / CCP_DTO: the CONNECT handshake (CRO_CMD = 0x01; DTO_PID = 0xFF).
+///   CCP_CRO / CCP_DTO: the CONNECT handshake, can::ccp::Layout (can/ccp.hpp),
+///                      which BenchLayout extends.
 ///
 /// The pilot pressure travels as the SPEC B1 sensor code
 /// raw = round((p/48.82 + 5.98)·(2¹⁶ − 1)/100); both ends convert with
@@ -18,40 +19,14 @@
 #include <cstdint>
 #include <filesystem>
 
-#include "lash/can/codec.hpp"
-#include "lash/can/dbc.hpp"
+#include "lash/can/bit_field.hpp"
+#include "lash/can/ccp.hpp"
 #include "lash/can/frame.hpp"
 
 namespace lash::hil {
 
-/// One signal of a frame as the DBC places it, coded by the CAN layer's SignalCodec
-/// (can/codec.hpp: Intel/Motorola bit placement, physical → raw rounding to nearest and
-/// clamping to the DBC range). All members are noexcept and O(1).
-class BitField {
- public:
-  /// An unsigned Intel signal: start bit (LSB), length, factor, physical range [lo, hi]
-  /// (lo == hi: no range). `intel = false` places it Motorola (start bit = MSB).
-  BitField(std::uint32_t start_bit, std::uint32_t length, double factor, double lo = 0.0, double hi = 0.0,
-           bool intel = true);
-  explicit BitField(const can::dbc::Signal& signal);
-
-  void put(can::Frame& f, std::uint64_t raw) const noexcept {
-    codec_.write_raw({f.data.data(), can::Frame::kMaxClassicLen}, raw);
-  }
-  std::uint64_t get(const can::Frame& f) const noexcept {
-    return codec_.read_raw({f.data.data(), can::Frame::kMaxClassicLen}).value_or(0);
-  }
-  /// physical → raw: rounds to nearest, clamps to the DBC range and the bit range.
-  std::uint64_t to_raw(double physical) const noexcept {
-    bool clamped = false;
-    return codec_.to_raw(physical, clamped);
-  }
-  double to_physical(std::uint64_t raw) const noexcept { return codec_.to_physical(raw); }
-  const can::dbc::Signal& signal() const noexcept { return codec_.signal(); }
-
- private:
-  can::SignalCodec codec_;
-};
+/// One signal of a frame as the DBC places it (can/bit_field.hpp).
+using can::BitField;
 
 /// Decoded BenchCommand.
 struct CommandMsg {
@@ -68,15 +43,16 @@ struct SensorMsg {
   std::uint16_t counter = 0;
 };
 
-struct BenchLayout {
-  std::uint32_t command_id = 0x100, sensors_id = 0x200, cro_id = 0x7E0, dto_id = 0x7E1;
-  std::uint8_t command_len = 8, sensors_len = 6, cro_len = 8;
+/// The bench's frames: its own command and sensor messages plus the CCP handshake
+/// (cro_id, dto_id, pack_connect, is_connect, is_connect_ack from can::ccp::Layout).
+struct BenchLayout : can::ccp::Layout {
+  std::uint32_t command_id = 0x100, sensors_id = 0x200;
+  std::uint8_t command_len = 8, sensors_len = 6;
   // Defaults: the layout of config/hydraulic_bench.dbc.
   BitField solenoid_a{0, 16, 0.1, 0, 2000}, solenoid_b{16, 16, 0.1, 0, 2000}, restrictor{32, 16, 0.1, 0, 2000},
       command_counter{48, 16, 1.0};
   BitField pilot{0, 16, 0.00152590218966964, 0, 100}, supply{16, 16, 0.00152590218966964, 0, 100},
       sensor_counter{32, 16, 1.0};
-  BitField cro_cmd{0, 8, 1.0}, cro_ctr{8, 8, 1.0}, dto_pid{0, 8, 1.0}, dto_err{8, 8, 1.0};
 
   /// Reads the layout from a DBC file. Throws lash::InputError naming the file and the
   /// missing message/signal (or a counter narrower than 8 bits). Not real-time safe.
@@ -86,11 +62,6 @@ struct BenchLayout {
   CommandMsg unpack_command(const can::Frame& f) const noexcept;
   can::Frame pack_sensors(const SensorMsg& m) const noexcept;
   SensorMsg unpack_sensors(const can::Frame& f) const noexcept;
-  /// CCP CONNECT request (CRO_CMD = 0x01, counter ctr).
-  can::Frame pack_connect(std::uint8_t ctr) const noexcept;
-  bool is_connect(const can::Frame& f) const noexcept;
-  /// A positive command-return DTO (PID 0xFF, error code 0x00).
-  bool is_connect_ack(const can::Frame& f) const noexcept;
 
   /// Current command quantisation: what the slave decodes for a commanded current [mA].
   double quantize_current(double mA) const noexcept { return solenoid_a.to_physical(solenoid_a.to_raw(mA)); }

@@ -1,10 +1,9 @@
 #pragma once
 /// @file data.hpp
 /// Loading a measured record as named numeric columns, independent of the file format.
-/// CSV is built in; other formats (e.g. MAT files) plug in with register_column_reader().
+/// A ".mat" file is read as MAT (io/mat.hpp), anything else as CSV (io/csv.hpp).
 /// Not real-time safe. Errors are lash::InputError naming file, line (where there is one) and column.
 #include <filesystem>
-#include <functional>
 #include <string>
 #include <vector>
 
@@ -19,13 +18,7 @@ struct ColumnData {
   std::size_t rows() const noexcept { return cols.empty() ? 0 : cols[0].size(); }
 };
 
-/// A reader returns exactly the requested columns (throwing InputError for a missing one).
-using ColumnReader = std::function<ColumnData(const std::filesystem::path& path, const std::vector<std::string>& names)>;
-
-/// Registers a reader for a lower-case file extension with the dot (".mat"). Replaces an earlier one.
-void register_column_reader(const std::string& extension, ColumnReader reader);
-
-/// Reads `names` from `path` with the reader registered for its extension, CSV otherwise.
+/// Reads exactly the columns `names` from `path` (MAT or CSV); InputError for a missing one.
 ColumnData load_columns(const std::filesystem::path& path, const std::vector<std::string>& names);
 
 /// Loads t, v, y for estimation: `names` = {t, v, y} column names; checks that t is strictly

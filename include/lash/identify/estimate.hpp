@@ -27,6 +27,10 @@ struct EstimateResult {
 double sample_period(std::span<const double> t, const std::string& file = "", const std::vector<int>& line_of_row = {},
                      const std::string& t_name = "t");
 
+/// The estimator settings for one record: `cfg` with the record's sample period `dt_s` [s] and
+/// the verdict's fit window starting where the job's reported NRMSE window does.
+EstimatorConfig config_for_record(EstimatorConfig cfg, const EstimationJob& job, double dt_s);
+
 /// Scores a finished run: the NRMSE window of `job` over t, y and the simulated output.
 EstimateResult score_estimate(const EstimateReport& report, double dt_s, const EstimationJob& job,
                               std::span<const double> t, std::span<const double> y, std::span<const double> ysim);

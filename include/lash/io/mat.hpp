@@ -33,10 +33,6 @@ CsvTable read_mat(const std::filesystem::path& path, const std::vector<std::stri
 /// Reads one real scalar (1×1) variable; InputError if absent or not a scalar.
 double read_mat_scalar(const std::filesystem::path& path, const std::string& variable);
 
-/// Registers read_mat as the reader of ".mat" files for lash::load_columns (identify/data.hpp),
-/// so `lash estimate` and every other record reader accept MAT files. Idempotent.
-void register_mat_reader();
-
 /// True if `path` ends in ".mat" (any case): the commands use it to pick the reader.
 bool is_mat_file(const std::filesystem::path& path);
 

@@ -1,4 +1,4 @@
-#include "lash/sweep/campaign.hpp"
+#include "lash/experiments/campaign.hpp"
 
 #include "lash/identify/config_file.hpp"
 

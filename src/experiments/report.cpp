@@ -8,7 +8,7 @@
 
 #include "lash/io/atomic_file.hpp"
 #include "lash/io/csv.hpp"
-#include "lash/sweep/sweep.hpp"
+#include "lash/experiments/sweep.hpp"
 
 namespace lash::sweep {
 namespace {

@@ -1,4 +1,4 @@
-#include "lash/control/tune.hpp"
+#include "lash/experiments/tune.hpp"
 
 #include <algorithm>
 #include <array>
