@@ -79,13 +79,17 @@ def run_dask(files, scheduler=None, workers=None):
                                dashboard_address=None)
         client = Client(cluster)
     try:
-        futures = client.map(identify, files, pure=False)
-        results = client.gather(futures)
+        return identify_on(client, files)
     finally:
         client.close()
         if cluster is not None:
             cluster.close()
-    return [row for rows in results for row in rows]
+
+
+def identify_on(client, files):
+    """Identifies every file on a connected dask.distributed Client (one task per record)."""
+    futures = client.map(identify, files, pure=False)
+    return [row for rows in client.gather(futures) for row in rows]
 
 
 def write_csv(path, rows):
