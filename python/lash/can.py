@@ -6,7 +6,7 @@ a log as a numpy structured array with the fields
 
 - ``timestamp`` [s] (float64, the log's time base),
 - ``id`` (uint32, 11- or 29-bit identifier),
-- ``flags`` (uint8: FLAG_EXTENDED, FLAG_REMOTE, FLAG_FD),
+- ``flags`` (uint8: FLAG_EXTENDED, FLAG_REMOTE, FLAG_FD, FLAG_BRS, FLAG_ESI, FLAG_ERROR),
 - ``dlc`` (uint8, data length in bytes),
 - ``data`` (64 × uint8, the first ``dlc`` bytes are the payload).
 
@@ -22,8 +22,12 @@ read_log = _can.read_log
 FLAG_EXTENDED: int = _can.FLAG_EXTENDED
 FLAG_REMOTE: int = _can.FLAG_REMOTE
 FLAG_FD: int = _can.FLAG_FD
+FLAG_BRS: int = _can.FLAG_BRS
+FLAG_ESI: int = _can.FLAG_ESI
+FLAG_ERROR: int = _can.FLAG_ERROR
 
-__all__ = ["Database", "read_log", "to_messages", "FLAG_EXTENDED", "FLAG_REMOTE", "FLAG_FD"]
+__all__ = ["Database", "read_log", "to_messages", "FLAG_EXTENDED", "FLAG_REMOTE", "FLAG_FD", "FLAG_BRS", "FLAG_ESI",
+           "FLAG_ERROR"]
 
 
 def to_messages(frames):
@@ -37,5 +41,7 @@ def to_messages(frames):
         out.append(_pycan.Message(timestamp=float(r["timestamp"]), arbitration_id=int(r["id"]),
                                   is_extended_id=bool(flags & FLAG_EXTENDED),
                                   is_remote_frame=bool(flags & FLAG_REMOTE), is_fd=bool(flags & FLAG_FD),
+                                  bitrate_switch=bool(flags & FLAG_BRS), error_state_indicator=bool(flags & FLAG_ESI),
+                                  is_error_frame=bool(flags & FLAG_ERROR),
                                   dlc=n, data=bytes(r["data"][:n])))
     return out

@@ -9,6 +9,7 @@
 #include "convert.hpp"
 #include "lash/can/codec.hpp"
 #include "lash/can/dbc.hpp"
+#include "lash/can/encode.hpp"
 #include "lash/can/log.hpp"
 #include "lash/io/error.hpp"
 
@@ -19,10 +20,11 @@ namespace {
 using can::dbc::MuxRole;
 
 /// Bits of the `flags` field of read_log()'s rows.
-enum : std::uint8_t { kExtended = 1, kRemote = 2, kFd = 4 };
+enum : std::uint8_t { kExtended = 1, kRemote = 2, kFd = 4, kBrs = 8, kEsi = 16, kError = 32 };
 
 std::uint8_t flags_of(const can::Frame& f) {
-  return static_cast<std::uint8_t>((f.extended ? kExtended : 0) | (f.remote ? kRemote : 0) | (f.fd ? kFd : 0));
+  return static_cast<std::uint8_t>((f.extended ? kExtended : 0) | (f.remote ? kRemote : 0) | (f.fd ? kFd : 0) |
+                                   (f.brs ? kBrs : 0) | (f.esi ? kEsi : 0) | (f.error ? kError : 0));
 }
 
 /// One row of read_log() (numpy structured dtype with the same offsets).
@@ -100,22 +102,23 @@ class Database {
     return out;
   }
 
-  /// encode(name, values) -> bytes of the message's size; signals not given are 0 (raw).
-  pyb::bytes encode(const pyb::handle& message, const pyb::dict& values) const {
+  /// encode(name, values) -> bytes, as `lash can encode` (lash::can::encode_message).
+  pyb::bytes encode(const pyb::handle& message, const pyb::dict& values, bool clamp) const {
     const can::dbc::Message* m = find(message, std::nullopt);
-    MessageCodec c(*m);
-    std::vector<double> v(c.signal_count());
-    for (std::size_t i = 0; i < v.size(); ++i)
-      v[i] = c.codec(i).signal().mux == MuxRole::multiplexed ? std::nan("") : c.codec(i).to_physical(0);
+    can::EncodeRequest req;
+    req.clamp = clamp;
     for (const auto& [k, val] : values) {
-      const std::string name = pyb::str(k);
-      const auto idx = c.index_of(name);
-      if (!idx) throw InputError(path_, 0, name, "message '" + m->name + "' has no such signal");
-      v[*idx] = val.cast<double>();
+      // numbers as the shortest round-trip text (Python's repr), VAL_ texts as they are
+      const std::string v = pyb::isinstance<pyb::str>(val) ? val.cast<std::string>()
+                                                           : pyb::repr(val).cast<std::string>();
+      req.values.emplace_back(pyb::str(k).cast<std::string>(), v);
     }
-    std::vector<std::uint8_t> data(m->size, 0);
-    if (!c.encode(v, data).ok) throw InputError(path_, 0, m->name, "cannot encode");
-    return pyb::bytes(reinterpret_cast<const char*>(data.data()), data.size());
+    const can::EncodeOutcome out = can::encode_message(db_, *m, req, path_);
+    if (!out.warnings.empty()) {
+      auto warn = pyb::module_::import("warnings").attr("warn");
+      for (const auto& w : out.warnings) warn(text(w));
+    }
+    return pyb::bytes(reinterpret_cast<const char*>(out.frame.data.data()), out.frame.len);
   }
 
   pyb::dict messages() const {
@@ -201,6 +204,9 @@ void bind_can(pyb::module_& root) {
   m.attr("FLAG_EXTENDED") = static_cast<int>(kExtended);
   m.attr("FLAG_REMOTE") = static_cast<int>(kRemote);
   m.attr("FLAG_FD") = static_cast<int>(kFd);
+  m.attr("FLAG_BRS") = static_cast<int>(kBrs);
+  m.attr("FLAG_ESI") = static_cast<int>(kEsi);
+  m.attr("FLAG_ERROR") = static_cast<int>(kError);
   pyb::class_<Database>(m, "Database", "Database(path): a DBC file (Vector CAN database) loaded by lash's reader.")
       .def(pyb::init<const std::string&>(), pyb::arg("path"))
       .def("decode", &Database::decode, pyb::arg("message"), pyb::arg("data") = pyb::none(), pyb::kw_only(),
@@ -209,14 +215,18 @@ void bind_can(pyb::module_& root) {
            "message: the frame's id (int; ids above 0x7FF are looked up as extended first), the message name, or a\n"
            "python-can can.Message (then data defaults to its data). Multiplexed signals not selected are left out.\n"
            "physical = raw * factor + offset, in each signal's unit (messages[name]['signals'][s]['unit']).")
-      .def("encode", &Database::encode, pyb::arg("message"), pyb::arg("values"),
-           "encode(name, values) -> bytes: values = {signal: physical value}; signals not given are raw 0.")
+      .def("encode", &Database::encode, pyb::arg("message"), pyb::arg("values"), pyb::kw_only(),
+           pyb::arg("clamp") = false,
+           "encode(name, values, *, clamp=False) -> bytes, as `lash can encode`: values = {signal: physical value\n"
+           "or VAL_ text}; a signal not given takes its GenSigStartValue (else raw 0). A value outside [min|max]\n"
+           "that fits the field is encoded with a warning (clamp=True clamps it); one that does not fit raises.")
       .def_property_readonly("messages", &Database::messages,
                              "dict name -> {id, extended, size [byte], signals: {name: {start_bit, length, byte_order,\n"
                              "is_signed, factor, offset, minimum, maximum, unit, multiplexor, mux_value}}}")
       .def_property_readonly("path", &Database::path);
   m.def("read_log", &read_log, pyb::arg("path"),
-        "read_log(path) -> numpy structured array (timestamp [s], id, flags, dlc [byte], data[64])");
+        "read_log(path) -> numpy structured array (timestamp [s], id, flags, dlc [byte], data[64]);\n"
+        "the format by extension: .asc (Vector ASCII), .blf (Vector binary), .trc (PEAK), else candump.");
 }
 
 }  // namespace lash::py

@@ -1,4 +1,5 @@
 """Shared helpers of the lash Python tests (run by ctest: PYTHONPATH, LASH, LASH_SOURCE_DIR set)."""
+import math
 import os
 import subprocess
 
@@ -14,6 +15,13 @@ E2_SETTINGS = dict(guess_left=-350.0, guess_right=350.0, pooled=True, method="iv
                    min_updates=50, rls={"lambda": 1.0, "p0": 1000.0, "eta0": [1.0, 1.0, 1.0]},
                    noise={"filter_length": 40, "filter_input": True, "derivative_filter_length": 20,
                           "derivative_threshold": 150.0, "align_delay": 10})
+
+
+def same_value(a, b):
+    """Equality where NaN equals NaN (results of two runs, cell by cell)."""
+    if isinstance(a, float) and math.isnan(a):
+        return isinstance(b, float) and math.isnan(b)
+    return a == b
 
 
 def run_lash(*args):

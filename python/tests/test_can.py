@@ -26,6 +26,8 @@ LOGS = sorted(p for p in glob.glob(os.path.join(CORPUS, "logs", "*", "*")) if os
 
 
 def close(a, b):
+    if math.isnan(a) or math.isnan(b):  # a float signal holding a NaN pattern
+        return math.isnan(a) and math.isnan(b)
     return a == b or abs(a - b) <= 1e-9 * max(1.0, abs(a), abs(b))
 
 
@@ -39,7 +41,7 @@ def canmatrix_db(path):
 def test_decode_equals_canmatrix():
     rng = random.Random(20261123)
     compared = files = 0
-    failures, not_loaded = [], []
+    failures, not_loaded, unmatched = [], [], []
     for path in DBCS:
         ref = canmatrix_db(path)
         if ref is None:
@@ -55,6 +57,12 @@ def test_decode_equals_canmatrix():
                 continue
             ext = bool(fr.arbitration_id.extended)
             mine = [m for m in db.messages.values() if m["id"] == fr.arbitration_id.id and m["extended"] == ext]
+            if not mine:  # an id above 0x7FF written without bit 31: lash reads it as extended (DESIGN.md)
+                mine = [m for m in db.messages.values() if m["id"] == fr.arbitration_id.id]
+                ext = mine[0]["extended"] if len(mine) == 1 else ext
+            if not mine:  # canmatrix failed on the file's BO_ lines and made up a frame (issue_199_extended.dbc)
+                unmatched.append("%s %s %#x" % (os.path.basename(path), fr.name, fr.arbitration_id.id))
+                continue
             assert len(mine) == 1, (path, fr.name)
             # signals in file order; canmatrix reads long names (SYSTEM_SIGNAL_LONG_SYMBOL) where
             # lash keeps the 32-character DBC names, so names are matched by position
@@ -87,6 +95,8 @@ def test_decode_equals_canmatrix():
     print("DBC files compared: %d, values: %d; not loaded by lash: %d" % (files, compared, len(not_loaded)))
     for n in not_loaded:
         print("  not loaded:", n)
+    print("canmatrix frames without a lash message:", unmatched)
+    assert len(unmatched) <= 2, unmatched
     assert not failures, "\n".join(failures[:20])
     assert files >= 60 and compared >= 10000
 
@@ -138,23 +148,41 @@ def test_read_log_equals_python_can():
             skipped.append("%s (lash: %s)" % (os.path.relpath(path, CORPUS), e))
             continue
         name = os.path.relpath(path, CORPUS)
+        if path.endswith(".trc"):
+            # python-can 4.1's TRCReader drops remote-request lines ("RR": "Unsupported type");
+            # lash reads them as remote frames. Compare the rest, and count those against the text.
+            rr = sum(1 for line in open(path, errors="replace") if " RR " in line)
+            remote = (got["flags"] & lash.can.FLAG_REMOTE) != 0
+            assert int(remote.sum()) == rr, (name, int(remote.sum()), rr)
+            got = got[~remote]
         assert got.dtype.names == ("timestamp", "id", "flags", "dlc", "data")
         assert len(got) == len(ref), (name, len(got), len(ref))
         for i, (g, m) in enumerate(zip(got, ref)):
             flags = int(g["flags"])
             where = "%s frame %d" % (name, i)
             assert math.isclose(g["timestamp"], m.timestamp, rel_tol=0, abs_tol=1e-6), (where, g["timestamp"], m.timestamp)
+            assert bool(flags & lash.can.FLAG_ERROR) == m.is_error_frame, where
+            if m.is_error_frame:  # the id of an error frame is its error class, not an identifier
+                continue
             assert int(g["id"]) == m.arbitration_id, where
             assert bool(flags & lash.can.FLAG_EXTENDED) == m.is_extended_id, where
             assert bool(flags & lash.can.FLAG_REMOTE) == m.is_remote_frame, where
-            assert bool(flags & lash.can.FLAG_FD) == m.is_fd, where
+            # a CAN FD frame has no remote form: python-can flags a remote CANFD line of an ASC file
+            # is_fd, lash reads it as a classic remote frame; the FD flag is compared for data frames
             if not m.is_remote_frame:
+                assert bool(flags & lash.can.FLAG_FD) == m.is_fd, where
+            if m.is_fd and not m.is_remote_frame:
+                assert bool(flags & lash.can.FLAG_BRS) == m.bitrate_switch, where
+                assert bool(flags & lash.can.FLAG_ESI) == m.error_state_indicator, where
+            if not (m.is_remote_frame or m.is_error_frame):
                 n = int(g["dlc"])
                 assert bytes(g["data"][:n]) == bytes(m.data), where
         compared.append(name)
     print("logs compared with python-can:", compared)
     print("skipped:", skipped)
-    assert any(c.startswith("logs/candump") for c in compared) or compared, compared
+    # every format lash reads is compared (candump, Vector ASC and BLF, PEAK TRC)
+    for fmt in ("candump", "vector-asc", "vector-blf", "peak-trc"):
+        assert any(c.startswith("logs/" + fmt) for c in compared), (fmt, compared, skipped)
     # to_messages gives python-can objects back
     if compared:
         msgs = lash.can.to_messages(lash.can.read_log(os.path.join(CORPUS, compared[0])))

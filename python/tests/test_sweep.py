@@ -1,11 +1,9 @@
 """lash.sweep: one dict per run, equal to the rows of `lash sweep`'s results CSV (read by Python's
 csv module) for a small campaign derived from E3; any thread count gives the same rows."""
 import csv
-import math
-import os
 
 import lash
-from conftest import SRC, run_lash
+from conftest import run_lash, same_value
 
 CAMPAIGN = """
 name = "E3 small"
@@ -40,12 +38,6 @@ def cell(text):
     return text
 
 
-def same(a, b):
-    if isinstance(a, float) and math.isnan(a):
-        return isinstance(b, float) and math.isnan(b)
-    return a == b
-
-
 def test_sweep_equals_cli_csv(tmp_path):
     camp = tmp_path / "small.toml"
     camp.write_text(CAMPAIGN)
@@ -58,8 +50,8 @@ def test_sweep_equals_cli_csv(tmp_path):
     for a, b in zip(py, cli):
         assert list(a) == list(b)
         for k in a:
-            assert same(a[k], b[k]), (k, a[k], b[k])
+            assert same_value(a[k], b[k]), (k, a[k], b[k])
     one = lash.sweep(str(camp), jobs=1)
-    assert all(same(a[k], b[k]) for a, b in zip(one, py) for k in a)
+    assert all(same_value(a[k], b[k]) for a, b in zip(one, py) for k in a)
     assert {r["waveform"] for r in py} == {"sine", "square"}
     assert all(0 <= r["nrmse"] < 1 for r in py)
