@@ -11,6 +11,7 @@
 #include "cli_common.hpp"
 #include "plot.hpp"
 #include "lash/identify/any_estimator.hpp"
+#include "lash/identify/estimate_report.hpp"
 #include "lash/identify/config_file.hpp"
 #include "lash/identify/data.hpp"
 #include "lash/identify/estimate.hpp"
@@ -50,9 +51,6 @@ std::vector<std::string> split_names(const std::string& text) {
   if (out.size() != 3) throw InputError("", 0, "--columns", "expected three names t,v,y, got '" + text + "'");
   return out;
 }
-
-/// 6 significant digits for a person ("-" for a missing value).
-std::string sig(double x) { return std::isfinite(x) ? fmt::format("{:.6g}", x) : std::string("-"); }
 
 int run(const EstimateOptions& o) {
   EstimatorConfig cfg;
@@ -120,15 +118,15 @@ int run(const EstimateOptions& o) {
   cfg = config_for_record(cfg, job, rec.dt_s);  // the verdict's fit window starts where the NRMSE's does
   const bool keep = !o.out.empty() || !o.plot.empty();
   const auto t_start = std::chrono::steady_clock::now();
-  const EstimationRun run = run_estimator(cfg, rec.v(), rec.y(), keep);
+  EstimationRun run = run_estimator(cfg, rec.v(), rec.y(), keep);
   const double elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   if (o.timing)
     fmt::print(stderr, "lash estimate: estimator ran {} samples in {} s ({:.3g} M samples/s)\n", rec.v().size(),
                format_double(elapsed_s), static_cast<double>(rec.v().size()) / elapsed_s * 1e-6);
+  add_intervals(run, cfg, rec.v(), rec.y());
   const auto& t = rec.t();
   const EstimateResult res = score_estimate(run.report, rec.dt_s, job, t, rec.y(), run.ysim);
   const double t1 = res.nrmse_t1_s;
-  const double fit = res.nrmse;
 
   if (!o.out.empty()) {
     std::vector<std::string> names{"t", "y", "yhat", "y_sim"};
@@ -173,32 +171,9 @@ int run(const EstimateOptions& o) {
     if (!tmp.empty()) std::filesystem::remove(tmp);
   }
 
-  const EstimateReport& r = run.report;
-  if (o.json) {
-    fmt::print("{}\n", to_json(res));
-  } else {
-    fmt::print("model {}: {} samples at dt = {} s, {} skipped\n", to_string(r.model), r.samples,
-               format_double(rec.dt_s), r.skipped);
-    auto show = [&](const char* name, const SideReport& s) {
-      std::string line = fmt::format("{:>6}: a1 = {}  b1 = {}", name, sig(s.params.a1), sig(s.params.b1));
-      if (r.has_c) line += "  c = " + sig(s.params.c);
-      if (r.has_side_d) line += "  d = " + sig(s.params.d);
-      line += "  K = " + sig(s.K) + "  tau = " + sig(s.tau_s) + " s";
-      line += s.params.identified ? "  identified" : fmt::format("  NOT identified ({})", to_string(s.params.reason));
-      line += "  updates";
-      for (const auto& [k, n] : s.updates) line += fmt::format(" {}:{}", k, n);
-      fmt::print("{}\n", line);
-    };
-    if (r.model == ModelKind::linear) show("model", r.right);
-    else {
-      show("right", r.right);
-      show("left", r.left);
-    }
-    if (r.has_shared_d) fmt::print("     d = {} (updates +:{} -:{}){}\n", sig(r.d), r.d_updates[0].second,
-                                   r.d_updates[1].second,
-                                   r.d_reason == Reason::none ? "" : fmt::format("  NOT identified ({})", to_string(r.d_reason)));
-    fmt::print("NRMSE of the simulated output over [{}, {}] s: {} %\n", sig(job.nrmse_t0_s), sig(t1), sig(100.0 * fit));
-  }
+  const ReportFit rf = report_fit(res);
+  if (o.json) fmt::print("{}\n", estimate_json(run.report, rf));
+  else fmt::print("{}", estimate_text(run.report, rec.dt_s, rf));
   return kExitOk;
 }
 

@@ -52,7 +52,7 @@ class Result:
     def __getitem__(self, key: str) -> Any: ...
 
 def estimate(t: ArrayLike, v: ArrayLike, y: ArrayLike, *, model: str = "deadzone-deadband", trace: bool = False,
-             **settings: Any) -> Result:
+             intervals: bool = True, **settings: Any) -> Result:
     """Identify a model from a whole record (t [s], v [input unit], y [output unit])."""
 
 class Estimator:
@@ -62,7 +62,7 @@ class Estimator:
         """One sample; returns the one-step prediction yhat [output unit]."""
     def update_many(self, v: ArrayLike, y: ArrayLike) -> npt.NDArray[np.float64]:
         """Many samples; returns yhat per sample."""
-    def result(self) -> Result: ...
+    def result(self, *, intervals: bool = True) -> Result: ...
     def reset(self) -> None: ...
     @property
     def samples(self) -> int: ...

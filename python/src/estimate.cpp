@@ -1,5 +1,6 @@
 // lash.estimate, lash.Estimator, lash.Result, lash.read_record: conversion only; the work is
-// lash::run_estimator / score_estimate / to_json, the same calls `lash estimate` makes.
+// lash::run_estimator / add_intervals / score_estimate / to_json (= estimate_json), the calls
+// `lash estimate` makes.
 #include <cmath>
 #include <memory>
 #include <optional>
@@ -82,14 +83,17 @@ class Estimator {
     return to_numpy(std::move(yhat));
   }
 
-  Result result() const {
-    Result r(score_estimate(est_->report(), cfg_.dt_s, job_, t_, y_, ysim_));
-    return r;
+  Result result(bool intervals) const {
+    EstimationRun run;
+    run.report = est_->report();
+    if (intervals) add_intervals(run, cfg_, v_, y_);
+    return Result(score_estimate(run.report, cfg_.dt_s, job_, t_, y_, ysim_));
   }
 
   void reset() {
     est_ = std::make_unique<AnyEstimator>(cfg_);
     t_.clear();
+    v_.clear();
     y_.clear();
     ysim_.clear();
   }
@@ -109,12 +113,14 @@ class Estimator {
  private:
   void reserve(std::size_t more) {
     t_.reserve(t_.size() + more);
+    v_.reserve(v_.size() + more);
     y_.reserve(y_.size() + more);
     ysim_.reserve(ysim_.size() + more);
   }
   double next_t() const noexcept { return static_cast<double>(t_.size()) * cfg_.dt_s; }
   void step(double v, double y, double t) {
     t_.push_back(t);
+    v_.push_back(v);
     y_.push_back(y);
     yhat_ = est_->step(v, y);
     ysim_.push_back(est_->simulated());
@@ -123,12 +129,12 @@ class Estimator {
   EstimatorConfig cfg_;
   EstimationJob job_;
   std::unique_ptr<AnyEstimator> est_;
-  std::vector<double> t_, y_, ysim_;
+  std::vector<double> t_, v_, y_, ysim_;
   double yhat_ = 0.0;
 };
 
 Result estimate(const pyb::handle& t_obj, const pyb::handle& v_obj, const pyb::handle& y_obj, const std::string& model,
-                bool trace, const pyb::kwargs& settings) {
+                bool trace, bool intervals, const pyb::kwargs& settings) {
   EstimatorConfig cfg;
   EstimationJob job;
   configure(cfg, job, model, settings);
@@ -145,6 +151,7 @@ Result estimate(const pyb::handle& t_obj, const pyb::handle& v_obj, const pyb::h
   {
     pyb::gil_scoped_release nogil;
     run.emplace(run_estimator(cfg, v, y, trace));
+    if (intervals) add_intervals(*run, cfg, v, y);
     res.emplace(score_estimate(run->report, dt, job, t, y, run->ysim));
   }
   Result r(std::move(*res));
@@ -198,14 +205,15 @@ void bind_estimate(pyb::module_& m) {
       .def("__repr__", [](const Result& r) { return "lash.Result(" + r.json + ")"; });
 
   m.def("estimate", &estimate, pyb::arg("t"), pyb::arg("v"), pyb::arg("y"), pyb::kw_only(),
-        pyb::arg("model") = "deadzone-deadband", pyb::arg("trace") = false,
-        "estimate(t, v, y, *, model='deadzone-deadband', trace=False, **settings) -> Result\n\n"
+        pyb::arg("model") = "deadzone-deadband", pyb::arg("trace") = false, pyb::arg("intervals") = true,
+        "estimate(t, v, y, *, model='deadzone-deadband', trace=False, intervals=True, **settings) -> Result\n\n"
         "Runs one of lash's switching estimators (SPEC A4) over a whole record, as `lash estimate` does.\n"
         "t [s] (strictly increasing, >= 3 samples; dt = mean step), v [input unit], y [output unit]: 1-D arrays\n"
         "of equal length (converted to contiguous float64 if needed). NaN samples of v or y are skipped and\n"
         "counted (Result.skipped). settings: the keys of an estimator config file (docs/identification.md),\n"
         "e.g. guess_left=-350, guess_right=350, rls={'lambda': 0.99, 'p0': 1000}, noise={'filter_length': 5},\n"
-        "nrmse_window=(7.5, 30.0). Raises lash.InputError (a ValueError) naming the key.");
+        "nrmse_window=(7.5, 30.0). intervals: the 95 % intervals (ci95, batch means: runs the estimator once\n"
+        "more over sections of the record), as `lash estimate`. Raises lash.InputError (a ValueError) naming the key.");
 
   pyb::class_<Estimator>(m, "Estimator",
                          "Estimator(model, dt_s, **settings): one estimator fed sample by sample (streaming).\n"
@@ -217,7 +225,8 @@ void bind_estimate(pyb::module_& m) {
       .def("update_many", &Estimator::update_many, pyb::arg("v"), pyb::arg("y"), pyb::arg("t") = pyb::none(),
            "update_many(v, y, t=None) -> yhat array: 1-D arrays of equal length (t [s] optional, as in update).\n"
            "Same bits as update() sample by sample.")
-      .def("result", &Estimator::result, "The Result after the samples so far (as lash.estimate would report).")
+      .def("result", &Estimator::result, pyb::kw_only(), pyb::arg("intervals") = true,
+           "The Result after the samples so far (as lash.estimate would report; intervals as there).")
       .def("reset", &Estimator::reset, "Back to the state before the first sample (same settings).")
       .def_property_readonly("samples", &Estimator::samples, "Samples fed so far.")
       .def_property_readonly("dt_s", &Estimator::dt_s, "Sample period [s].")

@@ -2,36 +2,10 @@
 
 #include <cmath>
 
-#include <nlohmann/json.hpp>
-
 #include "lash/io/csv.hpp"
 #include "lash/io/error.hpp"
 
 namespace lash {
-
-namespace {
-nlohmann::ordered_json num(double x) { return std::isfinite(x) ? nlohmann::ordered_json(x) : nlohmann::ordered_json(); }
-
-nlohmann::ordered_json updates_json(const std::vector<std::pair<std::string, std::uint64_t>>& updates) {
-  nlohmann::ordered_json u = nlohmann::ordered_json::object();
-  for (const auto& [k, n] : updates) u[k] = n;
-  return u;
-}
-
-/// One side's (linear: the model's) keys: a1, b1, c, d, identified, updates, the verdict's
-/// reason (null when identified), K and tau_s.
-void put_side(nlohmann::ordered_json& j, const EstimateReport& r, const SideReport& s) {
-  j["a1"] = num(s.params.a1);
-  j["b1"] = num(s.params.b1);
-  if (r.has_c) j["c"] = num(s.params.c);
-  if (r.has_side_d) j["d"] = num(s.params.d);
-  j["identified"] = s.params.identified;
-  j["updates"] = updates_json(s.updates);
-  j["reason"] = s.params.identified ? nlohmann::ordered_json() : nlohmann::ordered_json(to_string(s.params.reason));
-  j["K"] = num(s.K);
-  j["tau_s"] = num(s.tau_s);
-}
-}  // namespace
 
 double sample_period(std::span<const double> t, const std::string& file, const std::vector<int>& line_of_row,
                      const std::string& t_name) {
@@ -65,26 +39,8 @@ EstimateResult score_estimate(const EstimateReport& report, double dt_s, const E
   return r;
 }
 
-std::string to_json(const EstimateResult& res) {
-  const EstimateReport& r = res.report;
-  nlohmann::ordered_json j;
-  j["model"] = to_string(r.model);
-  j["samples"] = r.samples;
-  if (r.model == ModelKind::linear) {
-    put_side(j, r, r.right);
-  } else {
-    put_side(j["right"], r, r.right);
-    put_side(j["left"], r, r.left);
-  }
-  if (r.has_shared_d) {
-    j["d"] = num(r.d);
-    j["d_updates"] = updates_json(r.d_updates);
-    j["d_reason"] = r.d_reason == Reason::none ? nlohmann::ordered_json() : nlohmann::ordered_json(to_string(r.d_reason));
-  }
-  j["nrmse"] = num(res.nrmse);
-  j["nrmse_pct"] = num(100.0 * res.nrmse);
-  j["nrmse_window_s"] = {res.nrmse_t0_s, res.nrmse_t1_s};
-  return j.dump();
-}
+ReportFit report_fit(const EstimateResult& r) noexcept { return ReportFit{r.nrmse, r.nrmse_t0_s, r.nrmse_t1_s}; }
+
+std::string to_json(const EstimateResult& r) { return estimate_json(r.report, report_fit(r)); }
 
 }  // namespace lash

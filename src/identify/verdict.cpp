@@ -36,35 +36,6 @@ namespace {
 template <std::size_t N>
 using Mat = std::array<std::array<double, N>, N>;
 
-/// Inverse of a small matrix by Gauss–Jordan elimination with partial pivoting; false if singular.
-template <std::size_t N>
-bool invert(Mat<N> a, Mat<N>& inv) noexcept {
-  for (std::size_t i = 0; i < N; ++i)
-    for (std::size_t j = 0; j < N; ++j) inv[i][j] = i == j ? 1.0 : 0.0;
-  for (std::size_t c = 0; c < N; ++c) {
-    std::size_t piv = c;
-    for (std::size_t r = c + 1; r < N; ++r)
-      if (std::fabs(a[r][c]) > std::fabs(a[piv][c])) piv = r;
-    if (!(std::fabs(a[piv][c]) > 0.0)) return false;
-    std::swap(a[c], a[piv]);
-    std::swap(inv[c], inv[piv]);
-    const double f = 1.0 / a[c][c];
-    for (std::size_t j = 0; j < N; ++j) {
-      a[c][j] *= f;
-      inv[c][j] *= f;
-    }
-    for (std::size_t r = 0; r < N; ++r) {
-      if (r == c) continue;
-      const double g = a[r][c];
-      for (std::size_t j = 0; j < N; ++j) {
-        a[r][j] -= g * a[c][j];
-        inv[r][j] -= g * inv[c][j];
-      }
-    }
-  }
-  return true;
-}
-
 /// Smallest eigenvalue of a symmetric matrix (cyclic Jacobi rotations, Golub & Van Loan §8.5).
 template <std::size_t N>
 double min_eigenvalue(Mat<N> a) noexcept {
@@ -99,22 +70,21 @@ double min_eigenvalue(Mat<N> a) noexcept {
 
 template <std::size_t N>
 bool well_conditioned(const std::array<std::array<double, N>, N>& P) noexcept {
-  Mat<N> sym{};
-  for (std::size_t i = 0; i < N; ++i)
-    for (std::size_t j = 0; j < N; ++j) {
-      if (!std::isfinite(P[i][j])) return false;
-      sym[i][j] = 0.5 * (P[i][j] + P[j][i]);
-    }
-  Mat<N> info{};
-  if (!invert<N>(sym, info)) return false;
+  // cond(P⁻¹) = cond(P): scale the symmetrised covariance to unit diagonal (removes the units of
+  // the regressors) and look at its smallest eigenvalue. No inversion: a nearly singular
+  // information matrix is a P with one huge eigenvalue, which the scaling turns into a
+  // smallest eigenvalue near 0 that the Jacobi rotations resolve to rounding (1e-16).
   std::array<double, N> s{};
   for (std::size_t i = 0; i < N; ++i) {
-    if (!(info[i][i] > 0.0) || !std::isfinite(info[i][i])) return false;
-    s[i] = 1.0 / std::sqrt(info[i][i]);
+    if (!(P[i][i] > 0.0) || !std::isfinite(P[i][i])) return false;
+    s[i] = 1.0 / std::sqrt(P[i][i]);
   }
   Mat<N> scaled{};
   for (std::size_t i = 0; i < N; ++i)
-    for (std::size_t j = 0; j < N; ++j) scaled[i][j] = s[i] * 0.5 * (info[i][j] + info[j][i]) * s[j];
+    for (std::size_t j = 0; j < N; ++j) {
+      if (!std::isfinite(P[i][j])) return false;
+      scaled[i][j] = s[i] * (0.5 * (P[i][j] + P[j][i])) * s[j];
+    }
   return min_eigenvalue<N>(scaled) > kMinScaledEigenvalue;
 }
 

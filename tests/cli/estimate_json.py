@@ -35,8 +35,11 @@ with tempfile.TemporaryDirectory() as d:
     truth = {"right": dict(a1=-0.96, b1=0.1, c=200.0, d=30.0), "left": dict(a1=-0.94, b1=0.15, c=-300.0, d=50.0)}
     for side in ("right", "left"):
         s = j[side]
-        check(list(s.keys()) == ["a1", "b1", "c", "d", "identified", "updates", "reason", "K", "tau_s"],
+        check(list(s.keys()) == ["a1", "b1", "c", "d", "identified", "updates", "reason", "K", "tau_s", "ci95"],
               f"{side} keys {list(s)}")
+        ci = s["ci95"]
+        check(list(ci) == ["a1", "b1", "c", "d", "K", "tau_s"] and all(
+            ci[k][0] <= s[k] <= ci[k][1] for k in ("a1", "b1", "c", "d", "K", "tau_s")), f"{side} ci95 {ci}")
         check(s["identified"] is True and s["reason"] is None, f"{side} identified")
         # K = b1/(1 + a1), tau = -T/ln(-a1) with T = 5 ms, from the truth by hand
         K, tau = truth[side]["b1"] / (1 + truth[side]["a1"]), -0.005 / math.log(-truth[side]["a1"])
@@ -60,8 +63,8 @@ with tempfile.TemporaryDirectory() as d:
     out = subprocess.run([LASH, "estimate", "--model", "linear", data, "--json"], check=True, capture_output=True,
                          text=True).stdout
     j = json.loads(out)
-    check(list(j.keys()) == ["model", "samples", "a1", "b1", "identified", "updates", "reason", "K", "tau_s", "nrmse",
-                             "nrmse_pct", "nrmse_window_s"], f"linear keys {list(j)}")
+    check(list(j.keys()) == ["model", "samples", "a1", "b1", "identified", "updates", "reason", "K", "tau_s", "ci95",
+                             "nrmse", "nrmse_pct", "nrmse_window_s"], f"linear keys {list(j)}")
     # input-deadzone: no d; a side never excited is null + identified false
     out = subprocess.run([LASH, "estimate", "--model", "input-deadzone", "--guess-left", "-700",
                           "--guess-right", "350", data, "--json"], check=True, capture_output=True, text=True).stdout

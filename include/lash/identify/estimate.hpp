@@ -1,8 +1,9 @@
 #pragma once
 /// @file estimate.hpp
 /// One estimation over a whole record, as `lash estimate` and Python's `lash.estimate` do it:
-/// the sample period from t, the estimator run, the NRMSE score and the JSON result object.
-/// One implementation, so the CLI's `--json` and Python's `Result.to_dict()` cannot drift apart.
+/// the sample period from t, the settings for the record and the NRMSE score; the JSON object is
+/// estimate_json() of estimate_report.hpp. One implementation, so the CLI's `--json` and
+/// Python's `Result.to_dict()` cannot drift apart.
 /// Not real-time safe (allocates). Errors are lash::InputError naming file, line and column.
 #include <span>
 #include <string>
@@ -10,6 +11,7 @@
 
 #include "lash/identify/any_estimator.hpp"
 #include "lash/identify/config_file.hpp"
+#include "lash/identify/estimate_report.hpp"
 
 namespace lash {
 
@@ -35,7 +37,10 @@ EstimatorConfig config_for_record(EstimatorConfig cfg, const EstimationJob& job,
 EstimateResult score_estimate(const EstimateReport& report, double dt_s, const EstimationJob& job,
                               std::span<const double> t, std::span<const double> y, std::span<const double> ysim);
 
-/// The JSON object printed by `lash estimate --json` (one line, no newline). Non-finite numbers are null.
+/// The fit part of the report (estimate_json / estimate_text).
+ReportFit report_fit(const EstimateResult& result) noexcept;
+
+/// The JSON object printed by `lash estimate --json`: estimate_json(report, report_fit(result)).
 std::string to_json(const EstimateResult& result);
 
 }  // namespace lash

@@ -81,8 +81,9 @@ struct Evidence {
 Reason judge(const Evidence& e) noexcept;
 
 /// Condition test of the information matrix P⁻¹ of an RLS (check 2, not on the sample path:
-/// O(N³), no allocation): P⁻¹ (symmetrised) scaled to unit diagonal must have its smallest
-/// eigenvalue above `kMinScaledEigenvalue` (1e-10) — exactly or nearly collinear regressors fail.
+/// O(N³), no allocation). cond(P⁻¹) = cond(P): P (symmetrised) scaled to unit diagonal must have
+/// its smallest eigenvalue above `kMinScaledEigenvalue` (1e-10) — exactly or nearly collinear
+/// regressors (a correlation beyond 1 − 1e-10) fail.
 template <std::size_t N>
 bool well_conditioned(const std::array<std::array<double, N>, N>& P) noexcept;
 
