@@ -126,7 +126,6 @@ int run(const EstimateOptions& o) {
   add_intervals(run, cfg, rec.v(), rec.y());
   const auto& t = rec.t();
   const EstimateResult res = score_estimate(run.report, rec.dt_s, job, t, rec.y(), run.ysim);
-  const double t1 = res.nrmse_t1_s;
 
   if (!o.out.empty()) {
     std::vector<std::string> names{"t", "y", "yhat", "y_sim"};
