@@ -5,6 +5,8 @@
 #include <cmath>
 #include <vector>
 
+#include "lash/identify/auto.hpp"
+#include "lash/identify/auto_gate.hpp"
 #include "lash/identify/estimators.hpp"
 #include "lash/identify/rls.hpp"
 #include "lash/plant/plant.hpp"
@@ -78,6 +80,29 @@ void BM_DeadzoneDeadbandE2Settings(benchmark::State& s) {
   run<lash::DeadzoneDeadbandEstimator>(s, c);
 }
 BENCHMARK(BM_DeadzoneDeadbandE2Settings);
+
+// What `lash estimate rec.csv --model deadzone-deadband` runs per sample: lash's settings tuned to
+// the record (lash::tune_to_data), the guesses searched (lash::search_guesses, done once before),
+// and the outlier gate in front of the estimator.
+void BM_DeadzoneDeadbandDefault(benchmark::State& state) {
+  const Data& d = e1_data();
+  auto c = lash::preset_config(lash::ModelKind::deadzone_deadband, lash::Preset::lash, 0.005);
+  lash::tune_to_data(c, lash::analyse_record(d.v, d.y, 0.005));
+  const auto g = lash::search_guesses(c, d.v, d.y);
+  c.guess_right = g[0];
+  c.guess_left = g[1];
+  lash::DeadzoneDeadbandEstimator est(c);
+  lash::OutlierGate gate;
+  const std::size_t mask = d.v.size() - 1;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    double yhat = est.step(d.v[i], gate.step(d.y[i]));
+    benchmark::DoNotOptimize(yhat);
+    i = (i + 1) & mask;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_DeadzoneDeadbandDefault);
 
 void BM_InputDeadzone(benchmark::State& s) {
   run<lash::InputDeadzoneEstimator>(s, thesis(lash::ModelKind::input_deadzone));

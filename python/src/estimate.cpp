@@ -7,6 +7,7 @@
 
 #include "convert.hpp"
 #include "lash/identify/any_estimator.hpp"
+#include "lash/identify/auto.hpp"
 #include "lash/identify/config_file.hpp"
 #include "lash/identify/data.hpp"
 #include "lash/identify/estimate.hpp"
@@ -16,14 +17,36 @@ namespace lash::py {
 
 namespace {
 
-/// Settings as the keys of an estimator config file (docs/identification.md), checked once.
-void configure(EstimatorConfig& cfg, EstimationJob& job, const std::string& model, const pyb::dict& settings) {
-  pyb::dict all;
-  all["model"] = model;
-  for (const auto& [k, v] : settings) all[k] = v;
-  const toml::table tbl = to_toml(all);
+Preset preset_of(const std::string& name) {
+  try {
+    return parse_preset(name);
+  } catch (const std::invalid_argument& e) {
+    throw InputError("", 0, "preset", e.what());
+  }
+}
+
+ModelKind model_of(const std::string& name) {
+  try {
+    return parse_model_kind(name);
+  } catch (const std::invalid_argument& e) {
+    throw InputError("", 0, "model", e.what());
+  }
+}
+
+/// As `lash estimate` assembles them: the preset's settings, those chosen from the record (preset
+/// lash, when v and y are given), then the keys of an estimator config file (docs/identification.md).
+EstimatorConfig configure(EstimationJob& job, const std::string& model, const std::string& preset, double dt_s,
+                          const pyb::dict& settings, std::span<const double> v = {}, std::span<const double> y = {}) {
+  const ModelKind m = model_of(model);
+  const Preset p = preset_of(preset);
+  EstimatorConfig cfg = preset_config(m, p);
+  cfg.dt_s = dt_s;
+  if (p == Preset::lash && !v.empty()) tune_to_data(cfg, analyse_record(v, y, dt_s));
+  const toml::table tbl = to_toml(settings);
   TomlTable t(tbl, "");
   read_estimator_config(t, cfg, &job);
+  cfg.model = m;
+  return cfg;
 }
 
 void validate(EstimatorConfig& cfg, const EstimationJob& job, double dt_s) {
@@ -35,20 +58,43 @@ void validate(EstimatorConfig& cfg, const EstimationJob& job, double dt_s) {
   }
 }
 
+pyb::object num(double x) { return std::isfinite(x) ? pyb::object(pyb::float_(x)) : pyb::object(pyb::none()); }
+
 struct Result {
   EstimateResult res;
   std::string json;
   pyb::object yhat = pyb::none(), ysim = pyb::none(), params = pyb::none();
+  // what lash.estimate adds as `lash estimate --json` does (estimate_auto's report)
+  std::optional<AutoRun> autorun;
+  std::string preset;
 
   explicit Result(EstimateResult r) : res(std::move(r)), json(to_json(res)) {}
-  pyb::dict to_dict() const { return pyb::module_::import("json").attr("loads")(json); }
+  pyb::dict to_dict() const {
+    pyb::dict d = pyb::module_::import("json").attr("loads")(json);
+    if (!autorun) return d;
+    auto put_guess = [&](const char* side, const GuessReport& g) {
+      if (!d.contains(side) || g.source == GuessSource::unused) return;
+      pyb::dict s = d[side];
+      if (g.wrong_side) s["reason"] = "wrong_guess";
+      pyb::dict gd;
+      gd["value"] = num(g.guess);
+      gd["source"] = to_string(g.source);
+      gd["edge_seen"] = num(g.edge);
+      s["guess"] = gd;
+    };
+    put_guess("right", autorun->right);
+    put_guess("left", autorun->left);
+    d["outliers"] = autorun->outliers;
+    d["preset"] = preset;
+    return d;
+  }
 };
 
 class Estimator {
  public:
-  Estimator(const std::string& model, double dt_s, const pyb::kwargs& settings) {
-    configure(cfg_, job_, model, settings);
+  Estimator(const std::string& model, double dt_s, const std::string& preset, const pyb::kwargs& settings) {
     if (!(dt_s > 0) || !std::isfinite(dt_s)) throw InputError("", 0, "dt", "must be a finite number > 0 [s]");
+    cfg_ = configure(job_, model, preset, dt_s, settings);
     validate(cfg_, job_, dt_s);
     est_ = std::make_unique<AnyEstimator>(cfg_);
   }
@@ -134,10 +180,10 @@ class Estimator {
 };
 
 Result estimate(const pyb::handle& t_obj, const pyb::handle& v_obj, const pyb::handle& y_obj, const std::string& model,
-                bool trace, bool intervals, const pyb::kwargs& settings) {
-  EstimatorConfig cfg;
+                const std::string& preset, double outlier_gate, bool trace, bool intervals,
+                const pyb::kwargs& settings) {
   EstimationJob job;
-  configure(cfg, job, model, settings);
+  configure(job, model, preset, 1.0, settings);  // settings are checked before the data is looked at
   const DoubleArray ta = as_doubles(t_obj, "t"), va = as_doubles(v_obj, "v"), ya = as_doubles(y_obj, "y");
   const auto t = span_of(ta), v = span_of(va), y = span_of(ya);
   if (v.size() != t.size())
@@ -145,15 +191,17 @@ Result estimate(const pyb::handle& t_obj, const pyb::handle& v_obj, const pyb::h
   if (y.size() != t.size())
     throw InputError("", 0, "y", "has " + std::to_string(y.size()) + " samples, t has " + std::to_string(t.size()));
   const double dt = sample_period(t, "", {}, "t");
+  EstimatorConfig cfg = configure(job, model, preset, dt, settings, v, y);
   validate(cfg, job, dt);
-  std::optional<EstimationRun> run;
+  std::optional<AutoRun> ar;
   std::optional<EstimateResult> res;
   {
     pyb::gil_scoped_release nogil;
-    run.emplace(run_estimator(cfg, v, y, trace));
-    if (intervals) add_intervals(*run, cfg, v, y);
-    res.emplace(score_estimate(run->report, dt, job, t, y, run->ysim));
+    ar.emplace(estimate_auto(cfg, v, y, trace, outlier_gate));
+    if (intervals) add_intervals(ar->run, ar->cfg, v, y);
+    res.emplace(score_estimate(ar->run.report, dt, job, t, y, ar->run.ysim));
   }
+  EstimationRun* run = &ar->run;
   Result r(std::move(*res));
   r.yhat = to_numpy(std::move(run->yhat));
   r.ysim = to_numpy(std::move(run->ysim));
@@ -163,6 +211,9 @@ Result estimate(const pyb::handle& t_obj, const pyb::handle& v_obj, const pyb::h
       p[pyb::str(run->param_names[i])] = to_numpy(std::move(run->params[i]));
     r.params = p;
   }
+  run->params.clear();
+  r.autorun = std::move(ar);
+  r.preset = to_string(preset_of(preset));
   return r;
 }
 
@@ -205,8 +256,12 @@ void bind_estimate(pyb::module_& m) {
       .def("__repr__", [](const Result& r) { return "lash.Result(" + r.json + ")"; });
 
   m.def("estimate", &estimate, pyb::arg("t"), pyb::arg("v"), pyb::arg("y"), pyb::kw_only(),
-        pyb::arg("model") = "deadzone-deadband", pyb::arg("trace") = false, pyb::arg("intervals") = true,
-        "estimate(t, v, y, *, model='deadzone-deadband', trace=False, intervals=True, **settings) -> Result\n\n"
+        pyb::arg("model") = "deadzone-deadband", pyb::arg("preset") = "lash", pyb::arg("outlier_gate") = 12.0,
+        pyb::arg("trace") = false, pyb::arg("intervals") = true,
+        "estimate(t, v, y, *, model='deadzone-deadband', preset='lash', outlier_gate=12.0, trace=False,\n"
+        "         intervals=True, **settings) -> Result\n\n"
+        "As `lash estimate`: preset 'lash' (settings tuned to the data, guesses searched when not given) or\n"
+        "'thesis'; outlier_gate: isolated outliers of y beyond this many innovation scales are replaced (0 = off).\n"
         "Runs one of lash's switching estimators (SPEC A4) over a whole record, as `lash estimate` does.\n"
         "t [s] (strictly increasing, >= 3 samples; dt = mean step), v [input unit], y [output unit]: 1-D arrays\n"
         "of equal length (converted to contiguous float64 if needed). NaN samples of v or y are skipped and\n"
@@ -216,9 +271,12 @@ void bind_estimate(pyb::module_& m) {
         "more over sections of the record), as `lash estimate`. Raises lash.InputError (a ValueError) naming the key.");
 
   pyb::class_<Estimator>(m, "Estimator",
-                         "Estimator(model, dt_s, **settings): one estimator fed sample by sample (streaming).\n"
-                         "dt_s: sample period [s]; settings as for lash.estimate. The k-th sample is at t = k*dt_s.")
-      .def(pyb::init<const std::string&, double, const pyb::kwargs&>(), pyb::arg("model"), pyb::arg("dt_s"))
+                         "Estimator(model, dt_s, *, preset='thesis', **settings): one estimator fed sample by sample\n"
+                         "(streaming): the preset's static settings (nothing is chosen from data not seen yet), no\n"
+                         "guess search, no outlier gate. dt_s: sample period [s]; settings as for lash.estimate.\n"
+                         "The k-th sample is at t = k*dt_s.")
+      .def(pyb::init<const std::string&, double, const std::string&, const pyb::kwargs&>(), pyb::arg("model"),
+           pyb::arg("dt_s"), pyb::kw_only(), pyb::arg("preset") = "thesis")
       .def("update", &Estimator::update, pyb::arg("v"), pyb::arg("y"), pyb::arg("t_s") = pyb::none(),
            "update(v, y, t_s=None) -> yhat: one sample v [input unit], y [output unit] at time t_s [s]\n"
            "(default k*dt_s; only the NRMSE window uses it). Returns the one-step prediction [output unit].")
