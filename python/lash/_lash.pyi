@@ -51,13 +51,13 @@ class Result:
         """With trace=True: each parameter per sample (NaN while not identified)."""
     def __getitem__(self, key: str) -> Any: ...
 
-def estimate(t: ArrayLike, v: ArrayLike, y: ArrayLike, *, model: str = "deadzone-deadband", trace: bool = False,
-             intervals: bool = True, **settings: Any) -> Result:
+def estimate(t: ArrayLike, v: ArrayLike, y: ArrayLike, *, model: str = "deadzone-deadband", preset: str = "lash",
+             outlier_gate: float = 12.0, trace: bool = False, intervals: bool = True, **settings: Any) -> Result:
     """Identify a model from a whole record (t [s], v [input unit], y [output unit])."""
 
 class Estimator:
     """One estimator fed sample by sample; the k-th sample is at t = k*dt_s [s]."""
-    def __init__(self, model: str, dt_s: float, **settings: Any) -> None: ...
+    def __init__(self, model: str, dt_s: float, *, preset: str = "thesis", **settings: Any) -> None: ...
     def update(self, v: float, y: float) -> float:
         """One sample; returns the one-step prediction yhat [output unit]."""
     def update_many(self, v: ArrayLike, y: ArrayLike) -> npt.NDArray[np.float64]:

@@ -115,13 +115,13 @@ def test_nan_samples_skipped_and_counted(tmp_path):
     y = y.copy()
     nan_at = [10, 5000, 5001, 15000]
     y[nan_at] = np.nan
-    r = lash.estimate(t, v, y, **E2_SETTINGS)
+    r = lash.estimate(t, v, y, preset="thesis", outlier_gate=0, **E2_SETTINGS)
     assert r.skipped == 4 and r.samples == len(t)
-    clean = lash.estimate(t, v, np.where(np.isnan(y), 0.0, y), **E2_SETTINGS)
+    clean = lash.estimate(t, v, np.where(np.isnan(y), 0.0, y), preset="thesis", outlier_gate=0, **E2_SETTINGS)
     assert clean.skipped == 0
     d = r.to_dict()
     assert all(d[s][k] is not None for s in ("right", "left") for k in ("a1", "b1", "c", "d")), d
-    e = lash.Estimator("deadzone-deadband", r.dt_s, **E2_SETTINGS)
+    e = lash.Estimator("deadzone-deadband", r.dt_s, preset="thesis", **E2_SETTINGS)
     e.update_many(v, y, t=t)
     assert e.result().json == r.json
     path = tmp_path / "nan.csv"

@@ -38,6 +38,7 @@ def test_e2_equals_cli_json(e2_csv, tmp_path):
     r = lash.estimate(d["t"], d["v"], d["y"], model="deadzone-deadband", **E2_SETTINGS)
     py = r.to_dict()
     same(py, cli)
+    assert py["preset"] == "lash" and "outliers" in py
     # the comparison covers numbers, not nulls
     assert all(py[s][k] is not None for s in ("right", "left") for k in ("a1", "b1", "c", "d")), py
     assert abs(py["right"]["c"] - 200.0) < 10 and abs(py["left"]["c"] + 300.0) < 15, py
@@ -62,7 +63,9 @@ def test_streaming_equals_batch_bit_for_bit(e2_csv):
     t, v, y = d["t"][:12000], d["v"][:12000], d["y"][:12000]
     n = len(t)
     dt = (t[-1] - t[0]) / (n - 1)  # lash.estimate's dt: the mean step of t
-    batch = lash.estimate(t, v, y, **E2_SETTINGS)
+    # the streaming estimator has no data to choose settings from, no guess search, no outlier gate:
+    # lash.estimate with the thesis preset and the gate off runs exactly that estimator
+    batch = lash.estimate(t, v, y, preset="thesis", outlier_gate=0, **E2_SETTINGS)
 
     one = lash.Estimator("deadzone-deadband", dt, **E2_SETTINGS)
     yhat1 = np.array([one.update(a, b, t_s=ts) for a, b, ts in zip(v, y, t)])
@@ -70,6 +73,7 @@ def test_streaming_equals_batch_bit_for_bit(e2_csv):
     yhat2 = np.concatenate([many.update_many(v[:5000], y[:5000], t=t[:5000]),
                             many.update_many(v[5000:], y[5000:], t=t[5000:])])
     assert yhat1.tobytes() == yhat2.tobytes() == batch.yhat.tobytes()
+    # .json is the library's estimate_json (to_dict() adds the guess search and gate report)
     assert one.result().json == many.result().json == batch.json
     assert one.params().keys() == many.params().keys()
     # reset returns to the first sample's state
@@ -88,7 +92,7 @@ def test_default_time_base_is_k_dt():
     e = lash.Estimator("deadzone-deadband", dt, guess_left=-350, guess_right=350, nrmse_window=[5.0, 50.0])
     e.update_many(tr["v"], tr["y"])
     b = lash.estimate(np.arange(len(v)) * dt, tr["v"], tr["y"], guess_left=-350, guess_right=350,
-                      nrmse_window=[5.0, 50.0])
+                      nrmse_window=[5.0, 50.0], preset="thesis", outlier_gate=0)
     assert e.result().json == b.json
     assert b.nrmse_window_s == (5.0, 50.0)
 
