@@ -66,17 +66,10 @@ void BM_DeadzoneDeadband(benchmark::State& s) {
 BENCHMARK(BM_DeadzoneDeadband);
 
 void BM_DeadzoneDeadbandE2Settings(benchmark::State& s) {
-  auto c = thesis(lash::ModelKind::deadzone_deadband);
-  c.pooled = true;
-  c.method = lash::EstimationMethod::iv;
-  c.iv_delay = 45;
-  c.direction_run = 41;
-  c.rls.lambda = 1.0;
-  c.noise.filter_length = 40;
-  c.noise.filter_input = true;
-  c.noise.derivative_filter_length = 20;
-  c.noise.derivative_threshold = 150;
-  c.noise.align_delay = 10;
+  // E2's method (config/scenarios/e2.toml) = lash's static default for the model
+  auto c = lash::preset_config(lash::ModelKind::deadzone_deadband, lash::Preset::lash, 0.005);
+  c.guess_left = -350;
+  c.guess_right = 350;
   run<lash::DeadzoneDeadbandEstimator>(s, c);
 }
 BENCHMARK(BM_DeadzoneDeadbandE2Settings);

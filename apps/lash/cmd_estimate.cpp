@@ -2,6 +2,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <optional>
 
 #include <unistd.h>
@@ -28,6 +29,26 @@ void put_guess(nlohmann::ordered_json& j, const GuessReport& g) {
   if (g.source == GuessSource::unused) return;
   if (g.wrong_side) j["reason"] = "wrong_guess";
   j["guess"] = {{"value", num(g.guess)}, {"source", to_string(g.source)}, {"edge_seen", num(g.edge)}};
+}
+
+/// The final 95 % intervals by trace column name ("a1_r", "c_l", "d", …) for the plot's bands.
+std::map<std::string, std::pair<double, double>> ci95_columns(const EstimateReport& r) {
+  std::map<std::string, std::pair<double, double>> m;
+  const auto put = [&](const std::string& name, const Interval& iv) {
+    if (iv.valid()) m[name] = {iv.lo, iv.hi};
+  };
+  if (r.model == ModelKind::linear) {
+    put("a1", r.right.ci95.a1);
+    put("b1", r.right.ci95.b1);
+    return m;
+  }
+  for (const auto& [sfx, s] : {std::pair{"_r", &r.right}, std::pair{"_l", &r.left}}) {
+    put(std::string("a1") + sfx, s->ci95.a1);
+    put(std::string("b1") + sfx, s->ci95.b1);
+    put(std::string("c") + sfx, s->ci95.c);
+    put(std::string("d") + sfx, s->ci95.d);
+  }
+  return m;
 }
 
 int run(const EstimateOptions& o) {
@@ -110,7 +131,7 @@ int run(const EstimateOptions& o) {
       plot_estimate(csv, o.plot,
                     fmt::format("lash estimate --model {} {}", to_string(cfg.model),
                                 std::filesystem::path(o.data).filename().string()),
-                    run.param_names, t.back());
+                    run.param_names, t.back(), ci95_columns(run.report));
     } catch (...) {
       if (!tmp.empty()) std::filesystem::remove(tmp);
       throw;

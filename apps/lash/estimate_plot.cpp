@@ -25,7 +25,8 @@ std::string side_title(const std::string& col) {
 }  // namespace
 
 void plot_estimate(const std::string& csv, const std::string& png, const std::string& title,
-                   const std::vector<std::string>& param_names, double t_end_s) {
+                   const std::vector<std::string>& param_names, double t_end_s,
+                   const std::map<std::string, std::pair<double, double>>& ci95) {
   std::vector<Panel> panels;
   for (const auto& n : param_names) {
     const std::string base = n.substr(0, n.find('_'));
@@ -38,18 +39,31 @@ void plot_estimate(const std::string& csv, const std::string& png, const std::st
   std::string s;
   s += fmt::format("set terminal pngcairo noenhanced size 1200,{} font 'sans,10'\n", 230 * rows + 80);
   s += "set output '<OUTPUT>'\nset datafile separator ','\nset grid\n";
-  s += "set key outside right top vertical Left reverse width 2\nset lmargin 12\nset rmargin 22\n";
+  s += "set key outside right top vertical Left reverse width 2\nset lmargin 12\nset rmargin 28\n";
   s += fmt::format("set multiplot layout {},1 title '{}'\n", rows, title);
   const char* colors[] = {"#1f77b4", "#d62728"};
   for (const auto& p : panels) {
     s += fmt::format("set xlabel 't [s]'\nset ylabel '{}'\n", unit_of(p.base));
     std::string plot;
+    int obj = 0;
+    for (std::size_t i = 0; i < p.columns.size(); ++i) {
+      const auto band = ci95.find(p.columns[i]);
+      if (band == ci95.end() || !(band->second.first <= band->second.second)) continue;
+      s += fmt::format(
+          "set object {} rectangle from graph 0, first {:.17g} to graph 1, first {:.17g} fc rgb '{}' "
+          "fs transparent solid 0.18 noborder behind\n",
+          ++obj, band->second.first, band->second.second, colors[i % 2]);
+      plot += plot.empty() ? "plot " : ", ";
+      plot += fmt::format("NaN with boxes fs transparent solid 0.18 noborder lc rgb '{}' title '{} 95 % CI'",
+                          colors[i % 2], side_title(p.columns[i]));
+    }
     for (std::size_t i = 0; i < p.columns.size(); ++i) {
       plot += plot.empty() ? "plot " : ", ";
       plot += fmt::format("'{}' using (column('t')):(column('{}')) with lines lw 1.5 lc rgb '{}' title '{}'", csv,
                           p.columns[i], colors[i % 2], side_title(p.columns[i]));
     }
     s += plot + "\n";
+    for (int k = 1; k <= obj; ++k) s += fmt::format("unset object {}\n", k);
   }
   s += fmt::format("set xlabel 't [s] (last {:g} s)'\nset ylabel 'output y [y unit]'\nset xrange [{}:{}]\n",
                    t_end_s > 20.0 ? 20.0 : t_end_s, t_end_s > 20.0 ? t_end_s - 20.0 : 0.0, t_end_s);
