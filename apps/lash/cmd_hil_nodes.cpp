@@ -75,6 +75,7 @@ int run_slave(const SlaveOptions& o) {
     return kExitFailed;
   }
   hil::write_slave_csv(o.log, r);
+  hil::write_events(std::filesystem::path(o.log).replace_extension("").string() + ".events.csv", r.events);
   if (!o.stats.empty()) write_text(o.stats, hil::slave_stats_json(r));
   const auto tet = rt::tet_us(r.loop.records);
   const auto& f = r.stats.frames;
@@ -102,8 +103,9 @@ int run_master(const MasterOptions& o) {
   if (o.result_fd >= 0) hil::write_run(o.result_fd, r);
   hil::write_master_csv(o.log, r);
   if (!o.bus_log.empty()) hil::write_bus_log(o.bus_log, r);
-  hil::write_master_events(
-      o.events.empty() ? (std::filesystem::path(o.log).replace_extension("").string() + ".events.csv") : o.events, r);
+  hil::write_events(
+      o.events.empty() ? (std::filesystem::path(o.log).replace_extension("").string() + ".events.csv") : o.events,
+      r.events);
   if (!o.stats.empty()) write_text(o.stats, hil::master_stats_json(r, o.reference));
   for (const auto& e : r.events)
     fmt::print(stderr, "lash hil master: t = {:.3f} s (step {}): {}\n", e.t_s, e.step, to_string(e.kind));

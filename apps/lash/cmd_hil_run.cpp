@@ -85,7 +85,9 @@ void print_report(const hil::RunReport& r) {
   fmt::print("max |emulation - simulation|: {} kPa, {} mA over {} steps ({} steps used an off-schedule frame)\n",
              format_double(r.vs_simulation.max_abs_diff_kPa), format_double(r.vs_simulation.max_abs_diff_mA),
              r.vs_simulation.compared, r.off_schedule);
-  fmt::print("logs in {}/ (master.csv, master.events.csv, master_bus.log, slave.csv, *.json, report.json)\n", r.out_dir);
+  fmt::print("logs in {}/ (master.csv, master.events.csv, master_bus.log, slave.csv, slave.events.csv, *.json, "
+             "report.json)\n",
+             r.out_dir);
 }
 
 int run_run(const RunOptions& o) {

@@ -124,6 +124,8 @@ std::string summary_json(const Campaign& c, const Summary& s, const std::vector<
   j["share_good"] = s.share_good;
   j["median_nrmse"] = num(s.median_nrmse);
   j["worst_nrmse"] = num(s.worst_nrmse);
+  j["median_nrmse_pct"] = num(100.0 * s.median_nrmse);  // the same in percent, for a person
+  j["worst_nrmse_pct"] = num(100.0 * s.worst_nrmse);
   if (!results.empty()) {
     j["median_run"] = label(results[s.median_index].spec);
     j["worst_run"] = label(results[s.worst_index].spec);
@@ -131,7 +133,8 @@ std::string summary_json(const Campaign& c, const Summary& s, const std::vector<
   auto& pw = j["per_waveform"];
   pw = nlohmann::json::object();
   for (const auto& w : s.per_waveform)
-    pw[w.waveform] = {{"runs", w.runs}, {"good", w.good}, {"share_good", w.share_good}, {"median_nrmse", num(w.median_nrmse)}};
+    pw[w.waveform] = {{"runs", w.runs}, {"good", w.good}, {"share_good", w.share_good}, {"median_nrmse", num(w.median_nrmse)},
+                        {"median_nrmse_pct", num(100.0 * w.median_nrmse)}};
   j["sides_identified"] = s.sides_identified;
   j["sides_total"] = s.sides_total;
   j["identified_with_cl_gt_cr"] = s.unphysical_reported;
@@ -144,14 +147,20 @@ std::string summary_json(const Campaign& c, const Summary& s, const std::vector<
 }
 
 void write_results_csv(const std::string& path, const Campaign& c, const std::vector<RunResult>& results) {
-  (void)c;
   AtomicFile f(path);
+  f.stream() << results_csv_text(c, results);
+  f.commit();
+}
+
+std::string results_csv_text(const Campaign& c, const std::vector<RunResult>& results) {
+  (void)c;
+  std::string text;
   std::string line =
       "run,waveform,amplitude,frequency_rad_s,repeat,seed,nrmse,max_abs_y,"
       "a1_r,b1_r,c_r,K_r,tau_r_s,identified_r,updates_r,rejected_r,"
       "a1_l,b1_l,c_l,K_l,tau_l_s,identified_l,updates_l,rejected_l,"
       "d,identified_d,param_error,true_K_r,true_tau_r_s,true_c_r,true_K_l,true_tau_l_s,true_c_l,true_d\n";
-  f.stream() << line;
+  text += line;
   auto put = [&](double x) {
     line += ',';
     append_double(line, x);
@@ -187,9 +196,9 @@ void write_results_csv(const std::string& path, const Campaign& c, const std::ve
     }
     put(r.truth.d);
     line += '\n';
-    f.stream() << line;
+    text += line;
   }
-  f.commit();
+  return text;
 }
 
 }  // namespace lash::sweep

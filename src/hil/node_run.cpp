@@ -123,10 +123,13 @@ FrameStats frame_stats(const SeqTracker& seq, std::uint64_t sent, std::uint64_t 
   FrameStats f;
   f.sent = sent;
   f.received = seq.received;
+  f.accepted = seq.accepted;
   f.late = seq.late;
   f.lost = seq.lost;
-  f.duplicates = seq.duplicates;
+  f.duplicates = seq.drops[Drop::repeated];
   f.resyncs = seq.resyncs;
+  f.dropped = seq.drops.total();
+  f.dropped_by_reason = seq.drops.n;
   f.ignored = ignored;
   f.send_failures = send_failures;
   f.bus_filtered = bs.filtered;
@@ -179,6 +182,8 @@ SlaveRun run_slave_node(const BenchSettings& s, const SlaveRunOptions& o, const 
   }
   take_loop(loop, out.loop);
   out.log.assign(slave.log().begin(), slave.log().end());
+  out.events.assign(slave.events().begin(), slave.events().end());
+  out.stats.state = slave.state();
   out.stats.frames = frame_stats(slave.commands(), slave.frames_sent(), slave.ignored_frames(), slave.send_failures(),
                                  bus->stats());
   out.stats.controller = ctl.controller_stats();
@@ -270,25 +275,26 @@ double us(std::int64_t ns) { return static_cast<double>(ns) * 1e-3; }
 }  // namespace
 
 void write_slave_csv(const std::filesystem::path& path, const SlaveRun& r) {
-  std::vector<std::vector<double>> c(11);
+  std::vector<std::vector<double>> c(13);
   const std::size_t n = std::min(r.log.size(), r.loop.records.size());
   for (std::size_t i = 0; i < n; ++i) {
     const auto& l = r.log[i];
     const auto& rec = r.loop.records[i];
     const double row[] = {static_cast<double>(l.step), static_cast<double>(rec.release_ns) * 1e-9,
-                          static_cast<double>(l.command_counter), l.command_fresh ? 1.0 : 0.0, l.current_mA,
+                          static_cast<double>(l.state), static_cast<double>(l.command_counter),
+                          l.command_fresh ? 1.0 : 0.0, static_cast<double>(l.dropped), l.current_mA,
                           l.pressure_kPa, l.measured_kPa, static_cast<double>(l.pilot_raw), us(rec.tet_ns),
                           us(rec.io_ns), us(rec.wake_latency_ns)};
     for (std::size_t j = 0; j < c.size(); ++j) c[j].push_back(row[j]);
   }
   write_columns(path,
-                {"step", "t_s", "command_counter", "command_fresh", "current_mA", "pressure_kPa", "measured_kPa",
-                 "pilot_raw", "tet_us", "io_us", "wake_latency_us"},
+                {"step", "t_s", "state", "command_counter", "command_fresh", "dropped", "current_mA", "pressure_kPa",
+                 "measured_kPa", "pilot_raw", "tet_us", "io_us", "wake_latency_us"},
                 c);
 }
 
 void write_master_csv(const std::filesystem::path& path, const MasterRun& r) {
-  std::vector<std::vector<double>> c(13);
+  std::vector<std::vector<double>> c(15);
   const std::size_t n = std::min(r.log.size(), r.loop.records.size());
   for (std::size_t i = 0; i < n; ++i) {
     const auto& l = r.log[i];
@@ -296,20 +302,24 @@ void write_master_csv(const std::filesystem::path& path, const MasterRun& r) {
     const double row[] = {static_cast<double>(l.step), static_cast<double>(rec.release_ns) * 1e-9,
                           static_cast<double>(l.state), static_cast<double>(l.control_step), l.reference_kPa,
                           l.measured_kPa, static_cast<double>(l.sensor_counter), l.sensor_fresh ? 1.0 : 0.0,
-                          l.current_mA, l.command_sent ? static_cast<double>(l.command_counter) : -1.0,
+                          static_cast<double>(l.dropped), l.current_mA, l.integrator_mA,
+                          l.command_sent ? static_cast<double>(l.command_counter) : -1.0,
                           us(rec.tet_ns), us(rec.io_ns), us(rec.wake_latency_ns)};
     for (std::size_t j = 0; j < c.size(); ++j) c[j].push_back(row[j]);
   }
   write_columns(path,
                 {"step", "t_s", "state", "control_step", "reference_kPa", "measured_kPa", "sensor_counter",
-                 "sensor_fresh", "current_mA", "command_counter", "tet_us", "io_us", "wake_latency_us"},
+                 "sensor_fresh", "dropped", "current_mA", "integrator_mA", "command_counter", "tet_us", "io_us",
+                 "wake_latency_us"},
                 c);
 }
 
-void write_master_events(const std::filesystem::path& path, const MasterRun& r) {
+void write_events(const std::filesystem::path& path, const std::vector<NodeEvent>& events) {
   AtomicFile f(path);
-  f.stream() << "step,t_s,event\n";
-  for (const auto& e : r.events) f.stream() << e.step << ',' << format_double(e.t_s) << ',' << to_string(e.kind) << '\n';
+  f.stream() << "step,t_s,event,from,to\n";
+  for (const auto& e : events)
+    f.stream() << e.step << ',' << format_double(e.t_s) << ',' << to_string(e.kind) << ',' << to_string(e.from) << ','
+               << to_string(e.to) << '\n';
   f.commit();
 }
 
@@ -359,6 +369,8 @@ json loop_json(const NodeStats& st, const LoopTrace& t) {
 
 std::string slave_stats_json(const SlaveRun& r) {
   json j = loop_json(r.stats, r.loop);
+  j["state"] = to_string(r.stats.state);
+  j["events"] = detail::events_json(r.events);
   j["dto_replies"] = r.stats.dto_replies;
   j["seed"] = r.stats.seed;
   j["connected"] = r.stats.connected;
@@ -371,9 +383,7 @@ std::string master_stats_json(const MasterRun& r, const std::string& reference) 
   j["state"] = to_string(r.stats.state);
   j["control_steps"] = r.stats.control_steps;
   j["handshake_s"] = r.stats.handshake_s;
-  json ev = json::array();
-  for (const auto& e : r.events) ev.push_back({{"step", e.step}, {"t_s", e.t_s}, {"event", to_string(e.kind)}});
-  j["events"] = ev;
+  j["events"] = detail::events_json(r.events);
   j["reference"] = reference;
   return j.dump(2) + "\n";
 }
@@ -476,6 +486,7 @@ void write_run(int fd, const SlaveRun& run) {
   Writer w{fd};
   write_common(w, run.stats, run.loop);
   w.vec(run.log);
+  w.vec(run.events);
 }
 
 void write_run(int fd, const MasterRun& run) {
@@ -488,7 +499,7 @@ void write_run(int fd, const MasterRun& run) {
 
 bool read_run(int fd, SlaveRun& run) {
   Reader r{fd};
-  return read_common(r, run.stats, run.loop) && r.vec(run.log);
+  return read_common(r, run.stats, run.loop) && r.vec(run.log) && r.vec(run.events);
 }
 
 bool read_run(int fd, MasterRun& run) {

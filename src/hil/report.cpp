@@ -97,7 +97,7 @@ std::size_t off_schedule_steps(const std::vector<MasterStepLog>& master, const s
   for (const auto& l : slave) {
     const auto s = static_cast<std::int64_t>(l.step);
     if (s > 0 && s < control_steps &&
-        (!l.command_fresh || l.command_counter != static_cast<std::uint16_t>(s - 1)))
+        (!l.command_fresh || l.command_counter != static_cast<std::uint64_t>(s - 1)))
       off.insert(s);
   }
   return off.size();
@@ -129,13 +129,18 @@ void make_run_report(RunReport& rep, const MasterRun* master, const std::vector<
     rep.frames.lost += f.lost;
   };
   for (const auto& s : slaves) add(s.stats.frames);
-  if (rep.have_slave) rep.slave = node_figures(slaves[0].stats, slaves[0].loop);
+  if (rep.have_slave) {
+    rep.slave = node_figures(slaves[0].stats, slaves[0].loop);
+    rep.slave_events = slaves[0].events;
+    rep.slave_state = slaves[0].stats.state;
+  }
   if (!master) return;
   add(master->stats.frames);
   rep.master = node_figures(master->stats, master->loop);
   rep.handshake_s = master->stats.handshake_s;
   rep.control_steps = master->stats.control_steps;
   rep.events = master->events;
+  rep.master_state = master->stats.state;
   rep.vs_simulation = compare_with_simulation(master->log, simulated);
   rep.off_schedule = off_schedule_steps(master->log, rep.have_slave ? slaves[0].log : std::vector<SlaveStepLog>{},
                                         rep.control_steps);
@@ -201,12 +206,15 @@ std::string run_report_json(const RunReport& r) {
   if (r.have_master) {
     out["master"] = node_json(r.master);
     out["master"]["handshake_s"] = r.handshake_s;
-    json ev = json::array();
-    for (const auto& e : r.events) ev.push_back({{"step", e.step}, {"t_s", e.t_s}, {"event", to_string(e.kind)}});
-    out["master"]["events"] = ev;
+    out["master"]["events"] = detail::events_json(r.events);
+    out["master"]["state"] = to_string(r.master_state);
     out["master"]["control_steps"] = r.control_steps;
   }
-  if (r.have_slave) out["slave"] = node_json(r.slave);
+  if (r.have_slave) {
+    out["slave"] = node_json(r.slave);
+    out["slave"]["events"] = detail::events_json(r.slave_events);
+    out["slave"]["state"] = to_string(r.slave_state);
+  }
   out["frames"] = {{"sent", r.frames.sent}, {"received", r.frames.received}, {"late", r.frames.late},
                    {"lost", r.frames.lost}};
   json step = json::object();

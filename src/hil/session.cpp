@@ -168,9 +168,10 @@ void install_session_signal_handlers() {
 
 std::vector<std::string> session_files() {
   std::vector<std::string> f{"report.json", "master.csv", "master.json", "master.events.csv", "master_bus.log",
-                             "slave.csv",   "slave.json"};
+                             "slave.csv",   "slave.json", "slave.events.csv"};
   for (int i = 2; i <= 100; ++i) {
     f.push_back("slave." + std::to_string(i) + ".csv");
+    f.push_back("slave." + std::to_string(i) + ".events.csv");
     f.push_back("slave." + std::to_string(i) + ".json");
   }
   return f;

@@ -121,4 +121,11 @@ EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> 
   return run;
 }
 
+void add_intervals(EstimationRun& run, const EstimatorConfig& cfg, std::span<const double> v,
+                   std::span<const double> y) {
+  const auto ci = batch_means_intervals(cfg, v, y, {run.report.right.params, run.report.left.params});
+  if (run.report.right.params.identified) run.report.right.ci95 = ci.right;
+  if (run.report.left.params.identified) run.report.left.ci95 = ci.left;
+}
+
 }  // namespace lash

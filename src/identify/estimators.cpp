@@ -23,6 +23,13 @@ bool simulable(const std::array<double, 3>& e, double c) noexcept {
   return std::isfinite(e[0]) && std::isfinite(e[1]) && std::isfinite(e[2]) && std::fabs(e[0]) < 1.0 &&
          std::isfinite(c);
 }
+/// Verdict check 2's condition test. Least squares: P is the (scaled) inverse information
+/// matrix. Instrumental variables: P = (Σ z φᵀ)⁻¹ is not symmetric and not a covariance, so
+/// the test does not apply (the value-range checks still do).
+template <std::size_t N>
+bool conditioned(const EstimatorConfig& c, const Rls<N>& r) noexcept {
+  return c.method == EstimationMethod::iv || verdict_rules::well_conditioned<N>(r.P());
+}
 std::uint64_t fit_start_index(const EstimatorConfig& c) {
   return static_cast<std::uint64_t>(std::ceil(c.fit_start_s / c.dt_s - 1e-9));
 }
@@ -77,7 +84,7 @@ SideParams LinearEstimator::params() const noexcept {
 }
 
 Reason LinearEstimator::verdict(Side) const noexcept {
-  return verdict_rules::finish(params().reason, verdict_rules::well_conditioned<2>(rls_.P()), fit_.nrmse(), cfg_.fit_threshold);
+  return verdict_rules::finish(params().reason, conditioned(cfg_, rls_), fit_.nrmse(), cfg_.fit_threshold);
 }
 
 // ---------------------------------------------------------------- two-side deadzone estimators
@@ -126,7 +133,7 @@ double TwoSideEstimator::update(Side s, double y) noexcept {
 }
 
 Reason TwoSideEstimator::verdict(Side s) const noexcept {
-  return verdict_rules::finish(p_[s].reason, verdict_rules::well_conditioned<3>(rls_[s].P()), fit_.nrmse(), cfg_.fit_threshold);
+  return verdict_rules::finish(p_[s].reason, conditioned(cfg_, rls_[s]), fit_.nrmse(), cfg_.fit_threshold);
 }
 
 }  // namespace detail
@@ -390,9 +397,8 @@ SideParams DeadzoneDeadbandEstimator::params(Side s) const noexcept {
 }
 
 Reason DeadzoneDeadbandEstimator::verdict(Side s) const noexcept {
-  const bool cond = cfg_.pooled ? verdict_rules::well_conditioned<4>(pooled_[s].P())
-                                : verdict_rules::well_conditioned<3>(rls_[key(s, true)].P()) &&
-                                      verdict_rules::well_conditioned<3>(rls_[key(s, false)].P());
+  const bool cond = cfg_.pooled ? conditioned(cfg_, pooled_[s])
+                                : conditioned(cfg_, rls_[key(s, true)]) && conditioned(cfg_, rls_[key(s, false)]);
   return verdict_rules::finish(params(s).reason, cond, fit_.nrmse(), cfg_.fit_threshold);
 }
 
@@ -469,7 +475,7 @@ SideParams CoupledCartsEstimator::params(Side s) const noexcept {
 }
 
 Reason CoupledCartsEstimator::verdict(Side s) const noexcept {
-  return verdict_rules::finish(p_[s].reason, verdict_rules::well_conditioned<3>(rls_[s].P()), fit_.nrmse(), cfg_.fit_threshold);
+  return verdict_rules::finish(p_[s].reason, conditioned(cfg_, rls_[s]), fit_.nrmse(), cfg_.fit_threshold);
 }
 
 double CoupledCartsEstimator::deadband() const noexcept {

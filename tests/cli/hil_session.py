@@ -138,13 +138,18 @@ gap = rep["slave_restarts"][0]
 assert gap["died"]["signal"] == signal.SIGKILL and 0 < gap["gap_s"] < 2, gap
 assert len(rep["slave_exits"]) == 2 and rep["slave_exits"][1]["status"] == 0, rep["slave_exits"]
 events = [e["event"] for e in rep["master"]["events"]]
-assert "sensor_timeout_safe_state" in events and events[-1] == "sensor_resumed", events
+assert "sensor_timeout_safe_state" in events and events[-1] == "input_resumed", events
+last = rep["master"]["events"][-1]
+assert (last["from"], last["to"]) == ("safe", "running") and rep["master"]["state"] == "running", (last, rep["master"])
 assert rep["master"]["control_steps"] == 800
 m = hil_netns.read_csv(os.path.join(out3, "master.csv"))
-resumed = max(e["step"] for e in rep["master"]["events"] if e["event"] == "sensor_resumed")
+resumed = max(e["step"] for e in rep["master"]["events"] if e["event"] == "input_resumed")
 tail = [y for s, y in zip(m["step"], m["measured_kPa"]) if s >= resumed + 200]
 assert len(tail) > 50 and abs(sum(tail) / len(tail) - 1500) < 15, sum(tail) / len(tail)
 assert os.path.exists(os.path.join(out3, "slave.2.csv"))
+# The restarted slave writes its safe-state events next to its log.
+with open(os.path.join(out3, "slave.2.events.csv")) as f:
+    assert f.readline().strip() == "step,t_s,event,from,to"
 print(f"watchdog: slave restarted after {gap['gap_s']:.3f} s; tracking 1500 kPa again "
       f"(mean {sum(tail) / len(tail):.1f} kPa)")
 print("ok")

@@ -3,7 +3,12 @@ thesis §2.7.4): a python-can (Debian python3-can, udp_multicast interface) node
 speaks config/hydraulic_bench.dbc through canmatrix — it answers the CCP CONNECT with the
 recorded DTO read by python-can's CanutilsLogReader and sends sensor frames from its own
 simple plant — while `lash hil master` holds a step reference on it. Runs in a private
-network namespace (unshare -n)."""
+network namespace (unshare -n).
+
+The bench's frames are E2E-protected (CRC-8 SAE J1850 over the identifier and payload,
+alive counters): this slave computes the CRC with its own bit-by-bit implementation
+(checked against python3-crcmod and the catalogue check value), and checks the CRC and
+counter of every command frame lash's master sends."""
 import json
 import math
 import os
@@ -34,6 +39,12 @@ assert recorded, "no DTO in the recorded log"
 T = 0.005
 
 
+hil_netns.check_crc8_j1850()
+e2e_crc = hil_netns.e2e_crc
+CMD_CRC_BYTE = CMD.signal_by_name("Command_CRC").start_bit // 8
+SEN_CRC_BYTE = SEN.signal_by_name("Sensor_CRC").start_bit // 8
+
+
 class Plant:
     """Its own simple pilot-valve model: deadzone 288 mA, 2.15 kPa/mA, first-order 0.07 s
     (exact exponential discretisation), 90.1 kPa bias, no noise."""
@@ -49,7 +60,7 @@ class Plant:
 
 
 stop = threading.Event()
-stats = {"dto": 0, "sensors": 0, "commands": 0}
+stats = {"dto": 0, "sensors": 0, "commands": 0, "bad_crc": 0, "bad_counter": 0, "bad_dlc": 0}
 
 
 def slave():
@@ -73,6 +84,7 @@ def slave():
                 break
         t_next = time.monotonic() + T / 2
         counter = 0
+        last_ctr = None
         while not stop.is_set():
             delay = t_next - time.monotonic()
             if delay > 0:
@@ -83,13 +95,26 @@ def slave():
                 if msg is None:
                     break
                 if msg.arbitration_id == CMD.arbitration_id.id:
-                    current = float(CMD.decode(msg.data)["SolenoidA_Current"].phys_value)
+                    if len(msg.data) != CMD.size:
+                        stats["bad_dlc"] += 1
+                        continue
+                    if e2e_crc(msg.arbitration_id, msg.data, CMD_CRC_BYTE) != msg.data[CMD_CRC_BYTE]:
+                        stats["bad_crc"] += 1
+                        continue
+                    sig = CMD.decode(msg.data)
+                    ctr = int(sig["Command_Counter"].raw_value)
+                    if last_ctr is not None and ctr != (last_ctr + 1) % 256:
+                        stats["bad_counter"] += 1
+                    last_ctr = ctr
+                    current = float(sig["SolenoidA_Current"].phys_value)
                     stats["commands"] += 1
             p = plant.step(current)
             duty = p / 48.82 + 5.98
             raw = min(max(round(duty * 65535 / 100), 0), 65535)  # SPEC B1 sensor code
             # canmatrix's Frame.encode takes raw signal values and does the bit packing.
-            data = SEN.encode({"PilotPressure_Duty": raw, "SupplyPressure_Duty": 0, "Sensor_Counter": counter % 65536})
+            data = bytearray(SEN.encode({"PilotPressure_Duty": raw, "SupplyPressure_Duty": 0,
+                                         "Sensor_Counter": counter % 65536, "Sensor_CRC": 0}))
+            data[SEN_CRC_BYTE] = e2e_crc(SEN.arbitration_id.id, data, SEN_CRC_BYTE)
             bus.send(can.Message(arbitration_id=SEN.arbitration_id.id, data=data, is_extended_id=False))
             counter += 1
             stats["sensors"] += 1
@@ -114,8 +139,16 @@ def run_once(attempt):
     print(r.stderr)
     assert r.returncode == 0, r.stderr
     assert stats["dto"] == 1 and stats["commands"] > 500, stats
+    # Every command frame lash sent had the DBC's length and a CRC this independent
+    # implementation agrees with, and its alive counter advanced by one each time.
+    assert stats["bad_crc"] == 0 and stats["bad_dlc"] == 0 and stats["bad_counter"] == 0, stats
     with open(f"{out}/master.json") as f:
         ms = json.load(f)
+    # ... and the master accepted this slave's frames (CRC, counter, range): no drop.
+    print("master frames:", ms["frames"])
+    assert ms["frames"]["dropped"] == 0 and ms["frames"]["accepted"] > 500, ms["frames"]
+    assert [e["event"] for e in ms["events"]][:3] == ["ccp_connect_sent", "ccp_connected", "input_valid_running"], \
+        ms["events"]
     m = hil_netns.read_csv(f"{out}/master.csv")
     rows = [i for i, cs in enumerate(m["control_step"]) if cs >= 0]
     t = [m["control_step"][i] * T for i in rows]

@@ -28,7 +28,7 @@ MasterStepLog mrow(std::int64_t m, bool fresh, std::uint16_t counter, double y, 
   return l;
 }
 
-SlaveStepLog srow(std::uint32_t s, bool fresh, std::uint16_t counter) {
+SlaveStepLog srow(std::uint32_t s, bool fresh, std::uint64_t counter) {
   SlaveStepLog l;
   l.step = s;
   l.command_fresh = fresh;
@@ -83,8 +83,10 @@ TEST(HilRunReport, OffScheduleStepsByHand) {
   std::vector<SlaveStepLog> late = s.log;
   late.push_back(srow(5, false, 0));
   EXPECT_EQ(off_schedule_steps(m.log, late, 5), 3u);
-  // Counters are 16-bit: control step 65536 uses counter 0 and is on schedule.
-  EXPECT_EQ(off_schedule_steps({mrow(65536, true, 0, 0, 0)}, {srow(65537, true, 0)}, 70000), 0u);
+  // Sensor counters are 16-bit: control step 65536 uses counter 0 and is on schedule. The
+  // slave logs the command counter unwrapped: slave step 65537 needs 65536, not 0.
+  EXPECT_EQ(off_schedule_steps({mrow(65536, true, 0, 0, 0)}, {srow(65537, true, 65536)}, 70000), 0u);
+  EXPECT_EQ(off_schedule_steps({}, {srow(65537, true, 0)}, 70000), 1u);
   EXPECT_EQ(off_schedule_steps({mrow(65536, true, 1, 0, 0)}, {}, 70000), 1u);
 }
 
@@ -166,6 +168,21 @@ TEST(HilRunReport, HandOverRoundTrip) {
   ASSERT_EQ(back.events.size(), 1u);
   EXPECT_EQ(back.events[0].kind, MasterEventKind::sensor_timeout);
   EXPECT_EQ(back.stats.control_steps, 5);
+  // The slave's safe-state events and end state travel too.
+  const int sfd = memfd_create("slave", MFD_CLOEXEC);
+  ASSERT_GE(sfd, 0);
+  SlaveRun sr = slave_run();
+  sr.stats.state = NodeState::safe;
+  sr.events.push_back(NodeEvent{7, 0.035, NodeEventKind::ramp_done, NodeState::degraded, NodeState::safe});
+  write_run(sfd, sr);
+  SlaveRun sback;
+  ASSERT_TRUE(read_run(sfd, sback));
+  EXPECT_EQ(sback.stats.state, NodeState::safe);
+  ASSERT_EQ(sback.events.size(), 1u);
+  EXPECT_EQ(sback.events[0].step, 7u);
+  EXPECT_EQ(sback.events[0].from, NodeState::degraded);
+  EXPECT_EQ(sback.events[0].to, NodeState::safe);
+  close(sfd);
   // An empty or cut-short hand-over (a killed node) reads as nothing.
   const int empty = memfd_create("empty", MFD_CLOEXEC);
   SlaveRun s;

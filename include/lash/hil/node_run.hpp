@@ -5,6 +5,7 @@
 /// periodic loop, and what a run leaves behind (logs, loop records, counters) in memory.
 /// The option checks live here too, so that every face of the library refuses the same
 /// values with the same message before any work. Not real-time code, except the loops it runs.
+#include <array>
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include "lash/can/controller_bus.hpp"
+#include "lash/hil/e2e.hpp"
 #include "lash/hil/nodes.hpp"
 #include "lash/hil/settings.hpp"
 #include "lash/rt/periodic.hpp"
@@ -60,10 +62,14 @@ SlaveConfig slave_config(const BenchSettings& s, const BenchLayout& layout, std:
 MasterConfig master_config(const BenchSettings& s, const std::string& reference, double dto_timeout_s = 0.0,
                            std::size_t log_capacity = 0);
 
-/// Frame counters of one node at the end of its run.
+/// Frame counters of one node at the end of its run. received/accepted/late/lost/resyncs and
+/// the drops are those of the node's input message (SeqTracker, e2e.hpp); duplicates =
+/// dropped_by_reason[Drop::repeated].
 struct FrameStats {
-  std::uint64_t sent = 0, received = 0, late = 0, lost = 0, duplicates = 0, resyncs = 0, ignored = 0,
+  std::uint64_t sent = 0, received = 0, accepted = 0, late = 0, lost = 0, duplicates = 0, resyncs = 0, ignored = 0,
                 send_failures = 0, bus_filtered = 0, bus_dropped = 0, bus_log_dropped = 0;
+  std::uint64_t dropped = 0;                                ///< implausible frames dropped, all reasons
+  std::array<std::uint64_t, kDropReasons> dropped_by_reason{};  ///< indexed by Drop
 };
 
 /// What a node's run ends with, apart from its per-step logs (trivially copyable).
@@ -74,8 +80,8 @@ struct NodeStats {
   FrameStats frames;
   can::ControllerStats controller;
   bool dma_latency_held = false; ///< /dev/cpu_dma_latency was held at 0 during the loop
+  NodeState state = NodeState::startup;  ///< the safe-state machine's state at the end (nodes.hpp)
   // master only
-  MasterState state = MasterState::connecting;
   std::int64_t control_steps = 0;
   double handshake_s = -1.0;
   // slave only
@@ -95,13 +101,14 @@ struct SlaveRun {
   NodeStats stats;
   LoopTrace loop;
   std::vector<SlaveStepLog> log;
+  std::vector<NodeEvent> events;     ///< the safe-state machine's transitions
 };
 
 struct MasterRun {
   NodeStats stats;
   LoopTrace loop;
   std::vector<MasterStepLog> log;
-  std::vector<MasterEvent> events;
+  std::vector<NodeEvent> events;     ///< the safe-state machine's transitions and the handshake
   std::vector<LoggedFrame> bus_log;  ///< timestamps as the node saw them (see write_bus_log)
 };
 
@@ -133,7 +140,8 @@ void install_node_signal_handlers();
 /// Log files of a run (atomic writes; columns documented in docs/hil.md).
 void write_slave_csv(const std::filesystem::path& path, const SlaveRun& r);
 void write_master_csv(const std::filesystem::path& path, const MasterRun& r);
-void write_master_events(const std::filesystem::path& path, const MasterRun& r);
+/// A node's events CSV: `step,t_s,event,from,to`.
+void write_events(const std::filesystem::path& path, const std::vector<NodeEvent>& events);
 /// candump -L log of the frames the master sent and received, in wall-clock seconds: a sent
 /// frame carries its loop time (added to the loop's epoch), a received one the bus's receive
 /// timestamp, which is wall-clock already.

@@ -56,8 +56,8 @@ std::optional<StepResponse> step_response(const std::vector<double>& reference_k
                                           const std::vector<double>* measured_kPa = nullptr);
 
 /// Control steps that consumed another frame than the one meant for them: master step m must
-/// use the sensor frame of slave step m (fresh, counter m), slave step s (0 < s < control_steps)
-/// the command of master step s − 1 (fresh, counter s − 1), counters compared modulo 2¹⁶.
+/// use the sensor frame of slave step m (fresh, counter m modulo 2¹⁶), slave step s
+/// (0 < s < control_steps) the command of master step s − 1 (fresh, unwrapped counter s − 1).
 /// Late frames, lost frames or a node running late show up here.
 std::size_t off_schedule_steps(const std::vector<MasterStepLog>& master, const std::vector<SlaveStepLog>& slave,
                                std::int64_t control_steps);
@@ -102,7 +102,9 @@ struct RunReport {
   NodeFigures master, slave;              ///< slave: the first slave process
   double handshake_s = -1.0;
   std::int64_t control_steps = 0;
-  std::vector<MasterEvent> events;
+  std::vector<NodeEvent> events;          ///< the master's
+  std::vector<NodeEvent> slave_events;    ///< the first slave's
+  NodeState master_state = NodeState::startup, slave_state = NodeState::startup;  ///< at the end of the run
   FrameStats frames;                      ///< sent/received/late/lost summed over master + every slave
   std::optional<StepResponse> step;
   SimulationDiff vs_simulation;           ///< against the ideal-schedule simulation

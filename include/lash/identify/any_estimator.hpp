@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "lash/identify/estimators.hpp"
+#include "lash/identify/intervals.hpp"
 #include "lash/metrics/fit.hpp"  // nrmse, outside_3sigma_per_1000 (were declared here)
 
 namespace lash {
@@ -19,6 +20,7 @@ struct SideReport {
   SideParams params;  ///< NaN = not identified (JSON null); params.identified/reason: the full verdict
   double K = std::numeric_limits<double>::quiet_NaN();      ///< static gain b1/(1 + a1) [y unit / v unit]
   double tau_s = std::numeric_limits<double>::quiet_NaN();  ///< time constant −T/ln(−a1) [s]
+  SideIntervals ci95;  ///< 95 % intervals (batch means, intervals.hpp); only when asked for
   std::vector<std::pair<std::string, std::uint64_t>> updates;  ///< per key: "+"/"-" or "all"
 };
 
@@ -104,5 +106,9 @@ struct EstimationRun {
 /// Steps `cfg`'s estimator through v, y (same length). keep_trace stores the parameters per step.
 EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> v, std::span<const double> y,
                             bool keep_trace = false);
+/// Adds the 95 % intervals of every identified side's parameters to run.report (batch means,
+/// intervals.hpp: runs the estimator once more over sections of the same record).
+void add_intervals(EstimationRun& run, const EstimatorConfig& cfg, std::span<const double> v,
+                   std::span<const double> y);
 
 }  // namespace lash
