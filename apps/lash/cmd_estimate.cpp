@@ -33,6 +33,7 @@ struct EstimateOptions {
   std::string out;
   std::string plot;
   bool json = false;
+  bool strict = false;
   bool timing = false;
 };
 
@@ -128,7 +129,7 @@ int run(const EstimateOptions& o) {
     throw InputError(o.config, 0, "", e.what());
   }
 
-  const Record rec = load_record(o.data, job.columns);
+  const Record rec = load_record(o.data, job.columns, o.strict);
   cfg.dt_s = rec.dt_s;
   const bool keep = !o.out.empty() || !o.plot.empty();
   const auto t_start = std::chrono::steady_clock::now();
@@ -208,10 +209,18 @@ int run(const EstimateOptions& o) {
     }
     j["nrmse"] = num(fit);
     j["nrmse_window_s"] = {job.nrmse_t0_s, t1};
+    j["rows_skipped"] = rec.skipped_rows();
+    j["gaps"] = rec.gap_rows().size();
     fmt::print("{}\n", j.dump());
   } else {
     fmt::print("model {}: {} samples at dt = {} s, {} skipped\n", to_string(r.model), r.samples,
                format_double(rec.dt_s), r.skipped);
+    if (rec.skipped_rows())
+      fmt::print("data: {} rows with a non-finite value skipped (the first at line {})\n", rec.skipped_rows(),
+                 rec.data.first_skipped_line);
+    if (!rec.gap_rows().empty())
+      fmt::print("data: {} gaps in t (steps > {} x the median step {:.6g} s)\n", rec.gap_rows().size(),
+                 format_double(kGapFactor), rec.sampling.median_dt);
     auto show = [&](const char* name, const SideReport& s) {
       std::string line = fmt::format("{:>6}: a1 = {}  b1 = {}", name, format_double(s.params.a1),
                                      format_double(s.params.b1));
@@ -267,7 +276,8 @@ Command add_estimate(CLI::App& app) {
   sub->add_option("--accel-limit", o->accel_limit, "coupled-carts: max |acceleration| for stage 1 [y unit/s^2]");
   sub->add_option("--stage2-start", o->stage2_start, "coupled-carts: start of the deadband estimation [s]");
   sub->add_option("--zero-threshold", o->zero_threshold, "output-deadzone: |y| at or below this counts as 0");
-  sub->add_option("--columns", o->columns, "Names of the t,v,y columns, comma-separated (default t,v,y)");
+  sub->add_option("--columns", o->columns, "The t,v,y columns by name or 0-based index, comma-separated (default t,v,y)");
+  sub->add_flag("--strict", o->strict, "A row with a non-finite value (nan, inf, empty) is an error instead of skipped");
   sub->add_option("--nrmse-window", o->nrmse_window, "NRMSE window T0 T1 [s] (default 7.5 to the end)")
       ->expected(2);
   sub->add_option("-o,--output", o->out, "Trace CSV: t, y, yhat, y_sim and every parameter per step");

@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "lash/identify/estimators.hpp"
+#include "lash/io/error.hpp"
 #include "lash/signals/rng.hpp"
 
 namespace lash {
@@ -73,7 +74,7 @@ FirstOrderDeadzoneModel identify_online_on_rig(const rigs::PilotValveRigParams& 
   }
   const SideParams p = est.params(Side::right);
   if (!p.identified || !(p.a1 < 0 && p.a1 > -1) || !(p.b1 > 0))
-    throw std::runtime_error("online estimator did not identify the right side");
+    throw RunError("online estimator did not identify the right side");
   FirstOrderDeadzoneModel m;
   m.gain_kPa_per_mA = p.b1 / (1.0 + p.a1);
   m.tau_s = -dt_s / std::log(-p.a1);
