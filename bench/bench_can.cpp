@@ -3,10 +3,17 @@
 #include <benchmark/benchmark.h>
 
 #include <array>
+#include <cmath>
 #include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <vector>
 
 #include "lash/can/codec.hpp"
 #include "lash/can/datagram.hpp"
+#include "lash/can/log.hpp"
 
 namespace {
 
@@ -57,6 +64,86 @@ void BM_CanEncodeDecode4Intel(benchmark::State& s) { encode_decode(s, lash::can:
 void BM_CanEncodeDecode4Motorola(benchmark::State& s) { encode_decode(s, lash::can::dbc::ByteOrder::motorola); }
 BENCHMARK(BM_CanEncodeDecode4Intel);
 BENCHMARK(BM_CanEncodeDecode4Motorola);
+
+/// The floor: the Intel layout of four_signals() extracted by hand (constants folded by
+/// the compiler), with the same rounding (ties to even) and the same sign extension.
+void BM_CanHandWritten4Intel(benchmark::State& state) {
+  std::array<std::uint8_t, 8> data{};
+  std::array<double, 4> in{1234.5, 987.6, -42.5, 7};
+  std::array<double, 4> out{};
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(in.data());
+    const auto a = static_cast<std::uint64_t>(lash::can::round_half_even(in[0] * 10.0)) & 0xFFFF;
+    const auto b = static_cast<std::uint64_t>(lash::can::round_half_even(in[1] * 10.0)) & 0xFFFF;
+    const auto c = static_cast<std::uint64_t>(static_cast<std::int64_t>(lash::can::round_half_even((in[2] + 100.0) * 2.0))) & 0xFFF;
+    const auto d = static_cast<std::uint64_t>(lash::can::round_half_even(in[3])) & 0xF;
+    std::uint64_t w;
+    std::memcpy(&w, data.data(), 8);
+    w = (w & ~0xFFFFFFFFFFFFull) | a | (b << 16) | (c << 32) | (d << 44);
+    std::memcpy(data.data(), &w, 8);
+    std::uint64_t r;
+    std::memcpy(&r, data.data(), 8);
+    out[0] = static_cast<double>(r & 0xFFFF) * 0.1;
+    out[1] = static_cast<double>((r >> 16) & 0xFFFF) * 0.1;
+    out[2] = static_cast<double>(static_cast<std::int64_t>(r << 20) >> 52) * 0.5 - 100.0;
+    out[3] = static_cast<double>((r >> 44) & 0xF);
+    benchmark::DoNotOptimize(out.data());
+    benchmark::ClobberMemory();
+    in[0] += 0.1;
+  }
+  if (out[1] != 987.6 && out[1] != 987.6000000000001) state.SkipWithError("decode mismatch");
+}
+BENCHMARK(BM_CanHandWritten4Intel);
+
+/// Reading logs: 100 000 frames (classic, extended, FD) written once by lash in the
+/// format, then read with can::read_log; items/s = frames per second.
+void read_log_bench(benchmark::State& state, const char* ext) {
+  const auto path = std::filesystem::temp_directory_path() / (std::string("lash_bench_read") + ext);
+  std::vector<lash::can::LogEntry> v(100000);
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    auto& f = v[i].frame;
+    f.id = static_cast<std::uint32_t>(i % 0x7FF);
+    f.extended = i % 5 == 0;
+    f.fd = i % 7 == 0;
+    f.len = f.fd ? 16 : 8;
+    for (std::size_t k = 0; k < f.len; ++k) f.data[k] = static_cast<std::uint8_t>(i + k);
+    f.timestamp_s = 1700000000.0 + static_cast<double>(i) * 1e-4;
+    v[i].interface = "1";
+  }
+  lash::can::write_log(path, v);
+  std::size_t n = 0;
+  for (auto _ : state) {
+    const auto got = lash::can::read_log(path);
+    n += got.size();
+    benchmark::DoNotOptimize(got.data());
+  }
+  std::filesystem::remove(path);
+  state.SetItemsProcessed(static_cast<std::int64_t>(n));
+}
+void BM_CanReadAsc(benchmark::State& s) { read_log_bench(s, ".asc"); }
+void BM_CanReadBlf(benchmark::State& s) { read_log_bench(s, ".blf"); }
+void BM_CanReadTrc(benchmark::State& s) { read_log_bench(s, ".trc"); }
+void BM_CanReadCandump(benchmark::State& s) { read_log_bench(s, ".log"); }
+BENCHMARK(BM_CanReadAsc)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_CanReadBlf)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_CanReadTrc)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_CanReadCandump)->Unit(benchmark::kMillisecond);
+
+/// Loading a DBC file (read, parse, check every layout): the file named by LASH_BENCH_DBC
+/// (bench/dbc_load_vs_canmatrix.py passes the corpus's largest); skipped without it.
+void BM_CanLoadDbc(benchmark::State& state) {
+  const char* path = std::getenv("LASH_BENCH_DBC");
+  if (!path) {
+    state.SkipWithError("set LASH_BENCH_DBC to a DBC file");
+    return;
+  }
+  for (auto _ : state) {
+    std::vector<lash::can::dbc::Diagnostic> d;
+    const auto db = lash::can::dbc::load_dbc(path, {}, &d);
+    benchmark::DoNotOptimize(db.messages.data());
+  }
+}
+BENCHMARK(BM_CanLoadDbc)->Unit(benchmark::kMillisecond);
 
 void BM_CanDatagramEncodeDecode(benchmark::State& state) {
   lash::can::Frame f;

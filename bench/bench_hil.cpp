@@ -4,6 +4,7 @@
 
 #include <sched.h>
 
+#include <array>
 #include <chrono>
 #include <memory>
 #include <vector>
@@ -79,9 +80,56 @@ void BM_HilMasterStep(benchmark::State& state) {
     ++c;
     benchmark::DoNotOptimize(master.step(bus, 0.0));
   }
-  state.SetLabel("master step without bus I/O: drain, decode, PID + DZ inverse + saturation, encode, log");
+  state.SetLabel("master step without bus I/O: drain, plausibility check, decode, PID + DZ inverse + saturation, encode + CRC, log");
 }
 BENCHMARK(BM_HilMasterStep);
+
+// One plausibility check of a received frame, as a node runs it on every frame with its input
+// identifier: DLC, CRC-8 SAE J1850 over data ID + 7 payload bytes, the DBC range of every data
+// signal, and the alive counter's continuity (hil/e2e.hpp). Goal (issue 15): <= 20 ns.
+void BM_HilPlausibilitySensorFrame(benchmark::State& state) {
+  BenchLayout L;
+  std::vector<can::Frame> frames;
+  for (std::uint16_t c = 0; c < 1024; ++c) frames.push_back(L.pack_sensors({static_cast<std::uint16_t>(17000 + c), 0, c}));
+  SeqTracker t;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const can::Frame& f = frames[i++ & 1023];
+    bool ok = !L.check_sensors(f).has_value();
+    ok = ok && t.on_counter(static_cast<std::uint16_t>(L.checks.sensor_counter.get(L.sensor_counter, f, load_le(f))));
+    benchmark::DoNotOptimize(ok);
+  }
+  if (t.accepted + t.drops.total() != static_cast<std::uint64_t>(state.iterations())) state.SkipWithError("frames not counted");
+  state.SetLabel("DLC + CRC-8 + 2 ranges + counter of one BenchSensors frame");
+}
+BENCHMARK(BM_HilPlausibilitySensorFrame);
+
+void BM_HilPlausibilityCommandFrame(benchmark::State& state) {
+  BenchLayout L;
+  std::vector<can::Frame> frames;
+  for (std::uint16_t c = 0; c < 1024; ++c) frames.push_back(L.pack_command({800.0 + c, 0, 0, c}));
+  SeqTracker t;
+  t.bits = 8;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const can::Frame& f = frames[i++ & 1023];
+    bool ok = !L.check_command(f).has_value();
+    ok = ok && t.on_counter(static_cast<std::uint16_t>(L.checks.command_counter.get(L.command_counter, f, load_le(f))));
+    benchmark::DoNotOptimize(ok);
+  }
+  state.SetLabel("DLC + CRC-8 + 3 ranges + counter of one BenchCommand frame");
+}
+BENCHMARK(BM_HilPlausibilityCommandFrame);
+
+void BM_Crc8SaeJ1850NineBytes(benchmark::State& state) {
+  std::array<std::uint8_t, 9> b{'1', '2', '3', '4', '5', '6', '7', '8', '9'};
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(b);
+    benchmark::DoNotOptimize(Crc8SaeJ1850::compute(b));
+  }
+  state.SetLabel("table-driven CRC-8 SAE J1850 of 9 bytes (the E2E CRC's length)");
+}
+BENCHMARK(BM_Crc8SaeJ1850NineBytes);
 
 // The same step with every cache level flushed before it (a 32 MiB buffer rewritten between
 // steps, untimed): the worst case of a task woken after 5 ms of other work on the core.
@@ -120,7 +168,7 @@ void BM_HilSlaveStep(benchmark::State& state) {
     ++c;
     slave.step(bus, 0.0);
   }
-  state.SetLabel("slave step without bus I/O: drain, decode, plant (noise, sensor code), encode, log");
+  state.SetLabel("slave step without bus I/O: drain, plausibility check, decode, plant (noise, sensor code), encode + CRC, log");
 }
 BENCHMARK(BM_HilSlaveStep);
 

@@ -9,13 +9,13 @@ packages=(
   build-essential cmake ninja-build g++ clang pkg-config
   # libraries
   libeigen3-dev libcli11-dev libfmt-dev libtomlplusplus-dev nlohmann-json3-dev
-  libmatio-dev
+  libmatio-dev zlib1g-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev gnuplot-nox valgrind
   iproute2 util-linux
   # python oracles (Debian's /usr/bin/python3)
   python3 python3-numpy python3-scipy python3-statsmodels python3-can
-  python3-canmatrix python3-msgpack
+  python3-canmatrix python3-msgpack python3-crcmod
   # SocketCAN test under qemu
   qemu-system-x86 busybox-static cpio
   # libFuzzer / sanitizers runtime for clang

@@ -7,11 +7,11 @@
 #include <unistd.h>
 
 #include <fmt/core.h>
-#include <nlohmann/json.hpp>
 
 #include "cli_common.hpp"
 #include "plot.hpp"
 #include "lash/identify/any_estimator.hpp"
+#include "lash/identify/estimate_report.hpp"
 #include "lash/identify/config_file.hpp"
 #include "lash/identify/data.hpp"
 
@@ -50,21 +50,6 @@ std::vector<std::string> split_names(const std::string& text) {
     if (n.empty()) throw InputError("", 0, "--columns", "empty column name in '" + text + "'");
   if (out.size() != 3) throw InputError("", 0, "--columns", "expected three names t,v,y, got '" + text + "'");
   return out;
-}
-
-nlohmann::ordered_json num(double x) { return std::isfinite(x) ? nlohmann::ordered_json(x) : nlohmann::ordered_json(); }
-
-nlohmann::ordered_json side_json(const EstimateReport& r, const SideReport& s) {
-  nlohmann::ordered_json j;
-  j["a1"] = num(s.params.a1);
-  j["b1"] = num(s.params.b1);
-  if (r.has_c) j["c"] = num(s.params.c);
-  if (r.has_side_d) j["d"] = num(s.params.d);
-  j["identified"] = s.params.identified;
-  nlohmann::ordered_json u = nlohmann::ordered_json::object();
-  for (const auto& [k, n] : s.updates) u[k] = n;
-  j["updates"] = u;
-  return j;
 }
 
 int run(const EstimateOptions& o) {
@@ -131,13 +116,15 @@ int run(const EstimateOptions& o) {
 
   const Record rec = load_record(o.data, job.columns, o.strict);
   cfg.dt_s = rec.dt_s;
+  cfg.fit_start_s = job.nrmse_t0_s;  // the verdict's fit window starts where the reported NRMSE's does
   const bool keep = !o.out.empty() || !o.plot.empty();
   const auto t_start = std::chrono::steady_clock::now();
-  const EstimationRun run = run_estimator(cfg, rec.v(), rec.y(), keep);
+  EstimationRun run = run_estimator(cfg, rec.v(), rec.y(), keep);
   const double elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   if (o.timing)
     fmt::print(stderr, "lash estimate: estimator ran {} samples in {} s ({:.3g} M samples/s)\n", rec.v().size(),
                format_double(elapsed_s), static_cast<double>(rec.v().size()) / elapsed_s * 1e-6);
+  add_intervals(run, cfg, rec.v(), rec.y());
   const auto& t = rec.t();
   const double t1 = job.nrmse_t1_s < 0 ? t.back() : job.nrmse_t1_s;
   const double fit = nrmse(t, rec.y(), run.ysim, job.nrmse_t0_s, t1);
@@ -185,62 +172,10 @@ int run(const EstimateOptions& o) {
     if (!tmp.empty()) std::filesystem::remove(tmp);
   }
 
-  const EstimateReport& r = run.report;
-  if (o.json) {
-    nlohmann::ordered_json j;
-    j["model"] = to_string(r.model);
-    j["samples"] = r.samples;
-    if (r.model == ModelKind::linear) {
-      j["a1"] = num(r.right.params.a1);
-      j["b1"] = num(r.right.params.b1);
-      j["identified"] = r.right.params.identified;
-      nlohmann::ordered_json u = nlohmann::ordered_json::object();
-      for (const auto& [k, n] : r.right.updates) u[k] = n;
-      j["updates"] = u;
-    } else {
-      j["right"] = side_json(r, r.right);
-      j["left"] = side_json(r, r.left);
-    }
-    if (r.has_shared_d) {
-      j["d"] = num(r.d);
-      nlohmann::ordered_json u = nlohmann::ordered_json::object();
-      for (const auto& [k, n] : r.d_updates) u[k] = n;
-      j["d_updates"] = u;
-    }
-    j["nrmse"] = num(fit);
-    j["nrmse_window_s"] = {job.nrmse_t0_s, t1};
-    j["rows_skipped"] = rec.skipped_rows();
-    j["gaps"] = rec.gap_rows().size();
-    fmt::print("{}\n", j.dump());
-  } else {
-    fmt::print("model {}: {} samples at dt = {} s, {} skipped\n", to_string(r.model), r.samples,
-               format_double(rec.dt_s), r.skipped);
-    if (rec.skipped_rows())
-      fmt::print("data: {} rows with a non-finite value skipped (the first at line {})\n", rec.skipped_rows(),
-                 rec.data.first_skipped_line);
-    if (!rec.gap_rows().empty())
-      fmt::print("data: {} gaps in t (steps > {} x the median step {:.6g} s)\n", rec.gap_rows().size(),
-                 format_double(kGapFactor), rec.sampling.median_dt);
-    auto show = [&](const char* name, const SideReport& s) {
-      std::string line = fmt::format("{:>6}: a1 = {}  b1 = {}", name, format_double(s.params.a1),
-                                     format_double(s.params.b1));
-      if (r.has_c) line += "  c = " + format_double(s.params.c);
-      if (r.has_side_d) line += "  d = " + format_double(s.params.d);
-      line += s.params.identified ? "  identified" : "  NOT identified";
-      line += "  updates";
-      for (const auto& [k, n] : s.updates) line += fmt::format(" {}:{}", k, n);
-      fmt::print("{}\n", line);
-    };
-    if (r.model == ModelKind::linear) show("model", r.right);
-    else {
-      show("right", r.right);
-      show("left", r.left);
-    }
-    if (r.has_shared_d) fmt::print("     d = {} (updates +:{} -:{})\n", format_double(r.d), r.d_updates[0].second,
-                                   r.d_updates[1].second);
-    fmt::print("NRMSE of the simulated output over [{}, {}] s: {}\n", format_double(job.nrmse_t0_s),
-               format_double(t1), format_double(fit));
-  }
+  const ReportFit rf{fit, job.nrmse_t0_s, t1, rec.skipped_rows(), rec.data.first_skipped_line, rec.gap_rows().size(),
+                     rec.sampling.median_dt};
+  if (o.json) fmt::print("{}\n", estimate_json(run.report, rf));
+  else fmt::print("{}", estimate_text(run.report, rec.dt_s, rf));
   return kExitOk;
 }
 

@@ -169,6 +169,34 @@ can::ControllerConfig controller_config(std::int64_t period_ns) {
   return c;
 }
 
+/// Receive statistics of one cyclic message, with the plausibility drops per reason (hil/e2e.hpp).
+json frames_json(const hil::SeqTracker& t) {
+  json drops = json::object();
+  for (std::size_t i = 0; i < hil::kDropReasons; ++i)
+    drops[hil::to_string(static_cast<hil::Drop>(i))] = t.drops.n[i];
+  return json{{"received", t.received}, {"accepted", t.accepted}, {"late", t.late},
+              {"lost", t.lost},         {"duplicates", t.drops[hil::Drop::repeated]}, {"resyncs", t.resyncs},
+              {"dropped", t.drops.total()}, {"dropped_by_reason", drops}};
+}
+
+/// The safe-state machine's transitions (nodes.hpp).
+json events_json(std::span<const hil::NodeEvent> events) {
+  json ev = json::array();
+  for (const auto& e : events)
+    ev.push_back({{"step", e.step}, {"t_s", e.t_s}, {"event", to_string(e.kind)}, {"from", to_string(e.from)},
+                  {"to", to_string(e.to)}});
+  return ev;
+}
+
+void write_events(const std::string& path, std::span<const hil::NodeEvent> events) {
+  AtomicFile f(path);
+  f.stream() << "step,t_s,event,from,to\n";
+  for (const auto& e : events)
+    f.stream() << e.step << ',' << format_double(e.t_s) << ',' << to_string(e.kind) << ',' << to_string(e.from) << ','
+               << to_string(e.to) << '\n';
+  f.commit();
+}
+
 json controller_json(const can::ControllerBus& ctl) {
   const auto& cs = ctl.controller_stats();
   return json{{"rx_overflows", cs.rx_overflows}, {"tx_overflows", cs.tx_overflows}, {"tx_failures", cs.tx_failures},
@@ -241,11 +269,13 @@ int run_slave(const SlaveOptions& o) {
   // Logs (after the run; the loop stopped at a step boundary).
   const auto log = slave.log();
   const auto rec = loop.records();
-  std::vector<double> c_step, c_t, c_cnt, c_fresh, c_i, c_p, c_y, c_raw, c_tet, c_io, c_lat;
+  std::vector<double> c_step, c_t, c_state, c_cnt, c_fresh, c_drop, c_i, c_p, c_y, c_raw, c_tet, c_io, c_lat;
   for (std::size_t i = 0; i < log.size(); ++i) {
     c_step.push_back(log[i].step);
+    c_state.push_back(static_cast<double>(log[i].state));
+    c_drop.push_back(log[i].dropped);
     c_t.push_back(static_cast<double>(rec[i].release_ns) * 1e-9);
-    c_cnt.push_back(log[i].command_counter);
+    c_cnt.push_back(static_cast<double>(log[i].command_counter));
     c_fresh.push_back(log[i].command_fresh ? 1 : 0);
     c_i.push_back(log[i].current_mA);
     c_p.push_back(log[i].pressure_kPa);
@@ -256,20 +286,23 @@ int run_slave(const SlaveOptions& o) {
     c_lat.push_back(static_cast<double>(rec[i].wake_latency_ns) * 1e-3);
   }
   write_columns_csv(o.log,
-                    {"step", "t_s", "command_counter", "command_fresh", "current_mA", "pressure_kPa", "measured_kPa",
-                     "pilot_raw", "tet_us", "io_us", "wake_latency_us"},
-                    {&c_step, &c_t, &c_cnt, &c_fresh, &c_i, &c_p, &c_y, &c_raw, &c_tet, &c_io, &c_lat});
+                    {"step", "t_s", "state", "command_counter", "command_fresh", "dropped", "current_mA", "pressure_kPa",
+                     "measured_kPa", "pilot_raw", "tet_us", "io_us", "wake_latency_us"},
+                    {&c_step, &c_t, &c_state, &c_cnt, &c_fresh, &c_drop, &c_i, &c_p, &c_y, &c_raw, &c_tet, &c_io, &c_lat});
   json j = loop_json(loop, r, warnings);
   const auto& c = slave.commands();
   const auto bs = bus->stats();
-  j["frames"] = {{"sent", slave.frames_sent()},     {"received", c.received}, {"late", c.late},
-                 {"lost", c.lost},                   {"duplicates", c.duplicates}, {"resyncs", c.resyncs},
-                 {"ignored", slave.ignored_frames()}, {"send_failures", slave.send_failures()},
-                 {"bus_filtered", bs.filtered},      {"bus_dropped", bs.dropped}};
+  j["frames"] = frames_json(c);
+  j["frames"].update({{"sent", slave.frames_sent()}, {"ignored", slave.ignored_frames()},
+                      {"send_failures", slave.send_failures()}, {"bus_filtered", bs.filtered},
+                      {"bus_dropped", bs.dropped}});
+  j["state"] = to_string(slave.state());
+  j["events"] = events_json(slave.events());
   j["can_controller"] = controller_json(ctl);
   j["dto_replies"] = slave.dto_replies();
   j["seed"] = s.plant.seed;
   if (!o.stats.empty()) write_json(o.stats, j);
+  write_events(std::filesystem::path(o.log).replace_extension("").string() + ".events.csv", slave.events());
   const auto tet = loop.tet_us();
   fmt::print(stderr,
              "lash hil slave: {} steps ({}), TET mean {:.2f} us max {:.2f} us (CAN I/O mean {:.2f} us), overruns {}, "
@@ -303,12 +336,6 @@ hil::MasterConfig master_config(const hil::BenchSettings& s, const std::string& 
   return mc;
 }
 
-void write_events(const std::string& path, std::span<const hil::MasterEvent> events) {
-  AtomicFile f(path);
-  f.stream() << "step,t_s,event\n";
-  for (const auto& e : events) f.stream() << e.step << ',' << format_double(e.t_s) << ',' << to_string(e.kind) << '\n';
-  f.commit();
-}
 
 int run_master(const MasterOptions& o) {
   install_stop_handlers();
@@ -338,7 +365,7 @@ int run_master(const MasterOptions& o) {
   // Logs.
   const auto log = master.log();
   const auto rec = loop.records();
-  std::vector<double> c_step, c_t, c_state, c_m, c_r, c_y, c_sc, c_fresh, c_i, c_cc, c_tet, c_io, c_lat;
+  std::vector<double> c_step, c_t, c_state, c_m, c_r, c_y, c_sc, c_fresh, c_drop, c_i, c_int, c_cc, c_tet, c_io, c_lat;
   for (std::size_t i = 0; i < log.size() && i < rec.size(); ++i) {
     const auto& l = log[i];
     c_step.push_back(l.step);
@@ -349,7 +376,9 @@ int run_master(const MasterOptions& o) {
     c_y.push_back(l.measured_kPa);
     c_sc.push_back(l.sensor_counter);
     c_fresh.push_back(l.sensor_fresh ? 1 : 0);
+    c_drop.push_back(l.dropped);
     c_i.push_back(l.current_mA);
+    c_int.push_back(l.integrator_mA);
     c_cc.push_back(l.command_sent ? l.command_counter : -1.0);
     c_tet.push_back(static_cast<double>(rec[i].tet_ns) * 1e-3);
     c_io.push_back(static_cast<double>(rec[i].io_ns) * 1e-3);
@@ -357,8 +386,10 @@ int run_master(const MasterOptions& o) {
   }
   write_columns_csv(o.log,
                     {"step", "t_s", "state", "control_step", "reference_kPa", "measured_kPa", "sensor_counter",
-                     "sensor_fresh", "current_mA", "command_counter", "tet_us", "io_us", "wake_latency_us"},
-                    {&c_step, &c_t, &c_state, &c_m, &c_r, &c_y, &c_sc, &c_fresh, &c_i, &c_cc, &c_tet, &c_io, &c_lat});
+                     "sensor_fresh", "dropped", "current_mA", "integrator_mA", "command_counter", "tet_us", "io_us",
+                     "wake_latency_us"},
+                    {&c_step, &c_t, &c_state, &c_m, &c_r, &c_y, &c_sc, &c_fresh, &c_drop, &c_i, &c_int, &c_cc, &c_tet,
+                     &c_io, &c_lat});
   if (!o.bus_log.empty()) {
     std::vector<can::LogEntry> entries;
     entries.reserve(master.bus_log().size());
@@ -378,18 +409,15 @@ int run_master(const MasterOptions& o) {
   json j = loop_json(loop, r, warnings);
   const auto& sn = master.sensors();
   const auto bs = bus->stats();
-  j["frames"] = {{"sent", master.frames_sent()},     {"received", sn.received}, {"late", sn.late},
-                 {"lost", sn.lost},                   {"duplicates", sn.duplicates}, {"resyncs", sn.resyncs},
-                 {"ignored", master.ignored_frames()}, {"send_failures", master.send_failures()},
-                 {"bus_filtered", bs.filtered},       {"bus_dropped", bs.dropped},
-                 {"bus_log_dropped", master.bus_log_dropped()}};
+  j["frames"] = frames_json(sn);
+  j["frames"].update({{"sent", master.frames_sent()}, {"ignored", master.ignored_frames()},
+                      {"send_failures", master.send_failures()}, {"bus_filtered", bs.filtered},
+                      {"bus_dropped", bs.dropped}, {"bus_log_dropped", master.bus_log_dropped()}});
   j["can_controller"] = controller_json(ctl);
   j["state"] = to_string(master.state());
   j["control_steps"] = master.control_steps();
   j["handshake_s"] = master.handshake_s();
-  json ev = json::array();
-  for (const auto& e : master.events()) ev.push_back({{"step", e.step}, {"t_s", e.t_s}, {"event", to_string(e.kind)}});
-  j["events"] = ev;
+  j["events"] = events_json(master.events());
   j["reference"] = o.reference;
   if (!o.stats.empty()) write_json(o.stats, j);
 
@@ -693,6 +721,9 @@ int run_run(const RunOptions& o) {
   out["master"]["events"] = mj.at("events");
   out["master"]["control_steps"] = M;
   out["slave"] = node(sj);
+  out["slave"]["events"] = sj.at("events");
+  out["slave"]["state"] = sj.at("state");
+  out["master"]["state"] = mj.at("state");
   const auto& mf = mj.at("frames");
   const auto& sf = sj.at("frames");
   out["frames"] = {{"sent", mf.at("sent").get<std::uint64_t>() + sf.at("sent").get<std::uint64_t>()},
@@ -753,7 +784,9 @@ int run_run(const RunOptions& o) {
       fmt::print("step response: no reference step held >= 0.5 s in this run\n");
     fmt::print("max |emulation - simulation|: {} kPa, {} mA over {} steps ({} steps used an off-schedule frame)\n",
                format_double(diff.max_abs_diff_kPa), format_double(diff.max_abs_diff_mA), diff.compared, off.size());
-    fmt::print("logs in {}/ (master.csv, master.events.csv, master_bus.log, slave.csv, *.json, report.json)\n", dir);
+    fmt::print("logs in {}/ (master.csv, master.events.csv, master_bus.log, slave.csv, slave.events.csv, *.json, "
+               "report.json)\n",
+               dir);
   }
   return kExitOk;
 }

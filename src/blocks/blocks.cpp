@@ -30,8 +30,6 @@ FirstOrderParams FirstOrderParams::from_continuous(double gain, double tau_s, do
   return {-std::exp(x), -gain * std::expm1(x)};  // expm1: exact 1 − e^{−T/τ} for T ≪ τ
 }
 
-double FirstOrderParams::tau_s(double dt_s) const noexcept { return -dt_s / std::log(-a1); }
-
 FirstOrder::FirstOrder(PerSide<FirstOrderParams> p) : p_(p) {
   for (Side s : {Side::right, Side::left})
     require(finite(p[s].a1) && finite(p[s].b1), std::string("linear ") + to_string(s) + " a1/b1 must be finite");

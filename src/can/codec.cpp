@@ -226,20 +226,41 @@ std::uint64_t SignalCodec::to_raw(double physical, bool& clamped) const noexcept
 }
 
 MessageCodec::MessageCodec(const dbc::Message& message) : message_(message) {
-  codecs_.reserve(message.signals.size());
-  for (std::size_t i = 0; i < message.signals.size(); ++i) {
+  for (const auto& d : dbc::check_layout(message, "", false))
+    if (d.severity == dbc::Diagnostic::Severity::error) throw std::invalid_argument(d.message);
+  const std::size_t n = message.signals.size();
+  codecs_.reserve(n);
+  parent_.assign(n, -1);
+  range_begin_.push_back(0);
+  present_.assign(n, 1);
+  std::vector<std::size_t> depth(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
     const auto& s = message.signals[i];
     codecs_.emplace_back(s);
-    if (codecs_.back().min_bytes() > message.size)
-      throw std::invalid_argument(fmt::format("message '{}': signal '{}' needs {} bytes but the message has {}",
-                                              message.name, s.name, codecs_.back().min_bytes(), message.size));
     mux_values_.push_back(s.mux_value);
     multiplexed_.push_back(s.mux == dbc::MuxRole::multiplexed ? 1 : 0);
-    if (s.mux == dbc::MuxRole::multiplexor) {
+    if (s.mux == dbc::MuxRole::multiplexor && !has_mux_) {
       has_mux_ = true;
       mux_index_ = i;
     }
+    if (const dbc::Signal* p = message.multiplexor_of(s)) {
+      parent_[i] = static_cast<std::int32_t>(p - message.signals.data());
+      has_mux_ = true;
+      if (s.mux_ranges.empty()) {
+        ranges_.push_back({s.mux_value, s.mux_value});
+      } else {
+        ranges_.insert(ranges_.end(), s.mux_ranges.begin(), s.mux_ranges.end());
+      }
+    }
+    range_begin_.push_back(static_cast<std::uint32_t>(ranges_.size()));
+    for (const dbc::Signal* q = &s; q && q->mux == dbc::MuxRole::multiplexed; q = message.multiplexor_of(*q)) ++depth[i];
   }
+  for (std::size_t d = 0, left = n; left > 0; ++d)
+    for (std::size_t i = 0; i < n; ++i)
+      if (depth[i] == d) {
+        order_.push_back(static_cast<std::uint32_t>(i));
+        --left;
+      }
   packed_ = message.size <= 8;
   for (std::size_t i = 0; i < codecs_.size() && packed_; ++i) {
     const auto& s = message.signals[i];
@@ -254,7 +275,7 @@ MessageCodec::MessageCodec(const dbc::Message& message) : message_(message) {
     l.raw_lo = c.raw_lo_;
     l.raw_hi_excl = c.raw_hi_excl_;
     l.lo = static_cast<std::uint8_t>(c.lo_base_);  // window at byte 0
-    l.sext = static_cast<std::uint8_t>(64 - c.length_);
+    l.sext = static_cast<std::uint8_t>(c.signed_ ? 64 - c.length_ : 0);
     l.motorola = s.byte_order == dbc::ByteOrder::motorola;
     l.is_signed = c.signed_;
     l.has_range = c.has_range_;
@@ -264,10 +285,16 @@ MessageCodec::MessageCodec(const dbc::Message& message) : message_(message) {
     l.mux_value = s.mux_value;
     lanes_.push_back(l);
   }
-  for (std::size_t i = 0; i < multiplexed_.size(); ++i)
-    if (multiplexed_[i] && !has_mux_)
-      throw std::invalid_argument(fmt::format("message '{}': signal '{}' is multiplexed but there is no multiplexor",
-                                              message.name, message.signals[i].name));
+}
+
+bool MessageCodec::selected(std::size_t i, std::span<const std::uint8_t> data, std::span<const double> values) const noexcept {
+  const std::int32_t p = parent_[i];
+  if (p < 0) return true;
+  if (std::isnan(values[static_cast<std::size_t>(p)])) return false;  // the multiplexor itself is absent
+  const std::uint64_t raw = *codecs_[static_cast<std::size_t>(p)].read_raw(data);
+  for (std::uint32_t r = range_begin_[i]; r < range_begin_[i + 1]; ++r)
+    if (raw >= ranges_[r].lo && raw <= ranges_[r].hi) return true;
+  return false;
 }
 
 std::optional<std::size_t> MessageCodec::index_of(std::string_view signal_name) const noexcept {
@@ -294,54 +321,44 @@ bool MessageCodec::decode(std::span<const std::uint8_t> data, std::span<double> 
   if (packed_) {
     const std::uint64_t le = load_le(data, message_.size);
     const std::uint64_t words[2] = {le, __builtin_bswap64(le)};  // [motorola]
-    std::uint64_t mux = 0;
-    if (has_mux_) {
-      const Lane& m = lanes_[mux_index_];
-      mux = (words[m.motorola] >> m.lo) & m.mask;
-    }
     const std::size_t n = lanes_.size();
     for (std::size_t i = 0; i < n; ++i) {
       const Lane& l = lanes_[i];
-      if (l.multiplexed && l.mux_value != mux) {
-        values[i] = std::numeric_limits<double>::quiet_NaN();
-        continue;
-      }
       const std::uint64_t raw = (words[l.motorola] >> l.lo) & l.mask;
-      if (!l.integer) {
-        values[i] = codecs_[i].to_physical(raw);
-        continue;
-      }
-      double v;
-      if (l.is_signed) {
-        v = static_cast<double>(static_cast<std::int64_t>(raw << l.sext) >> l.sext);
-      } else if (!l.full64) {
-        v = static_cast<double>(static_cast<std::int64_t>(raw));
+      if (l.integer && !(l.full64 && !l.is_signed)) {
+        values[i] = static_cast<double>(static_cast<std::int64_t>(raw << l.sext) >> l.sext) * l.factor + l.offset;
       } else {
-        v = static_cast<double>(raw);
+        values[i] = codecs_[i].to_physical(raw);
       }
-      values[i] = v * l.factor + l.offset;
     }
-    return true;
+  } else {
+    for (std::size_t i = 0; i < codecs_.size(); ++i) values[i] = *codecs_[i].decode(data);
   }
-  std::uint64_t mux = 0;
-  if (has_mux_) mux = *codecs_[mux_index_].read_raw(data);
-  for (std::size_t i = 0; i < codecs_.size(); ++i) {
-    if (multiplexed_[i] && mux_values_[i] != mux) {
-      values[i] = std::numeric_limits<double>::quiet_NaN();
-      continue;
-    }
-    values[i] = *codecs_[i].decode(data);
-  }
+  if (has_mux_)
+    for (const std::uint32_t i : order_)
+      if (!selected(i, data, values)) values[i] = std::numeric_limits<double>::quiet_NaN();
   return true;
 }
 
 MessageCodec::EncodeResult MessageCodec::encode(std::span<const double> values, std::span<std::uint8_t> data) noexcept {
   EncodeResult res;
   if (values.size() != codecs_.size() || data.size() < message_.size) return res;
-  std::uint64_t mux = 0;
-  if (has_mux_) {
-    bool ignored = false;
-    mux = codecs_[mux_index_].to_raw(values[mux_index_], ignored);
+  // Which signals the multiplexors' encoded values select (multiplexors first).
+  for (const std::uint32_t i : order_) {
+    const std::int32_t p = parent_[i];
+    bool on = true;
+    if (p >= 0) {
+      const auto pi = static_cast<std::size_t>(p);
+      on = present_[pi] && !std::isnan(values[pi]) && !std::isnan(values[i]);
+      if (on) {
+        bool ignored = false;
+        const std::uint64_t raw = codecs_[pi].to_raw(values[pi], ignored);
+        on = false;
+        for (std::uint32_t r = range_begin_[i]; r < range_begin_[i + 1]; ++r)
+          if (raw >= ranges_[r].lo && raw <= ranges_[r].hi) on = true;
+      }
+    }
+    present_[i] = on ? 1 : 0;
   }
   if (packed_) {
     // Bits to clear/set, kept per byte order and merged into one word at the end.
@@ -350,7 +367,7 @@ MessageCodec::EncodeResult MessageCodec::encode(std::span<const double> values, 
     for (std::size_t i = 0; i < n; ++i) {
       const Lane& l = lanes_[i];
       const double p0 = values[i];
-      if (l.multiplexed && (l.mux_value != mux || std::isnan(p0))) continue;
+      if (!present_[i]) continue;
       std::uint64_t raw;
       bool clamped = false;
       if (!l.integer) {
@@ -407,7 +424,7 @@ MessageCodec::EncodeResult MessageCodec::encode(std::span<const double> values, 
     return res;
   }
   for (std::size_t i = 0; i < codecs_.size(); ++i) {
-    if (multiplexed_[i] && (mux_values_[i] != mux || std::isnan(values[i]))) continue;
+    if (!present_[i]) continue;
     if (codecs_[i].encode(values[i], data) == SignalCodec::Status::clamped) ++res.clamped;
   }
   clamp_count_ += res.clamped;

@@ -209,7 +209,7 @@ const char* to_string(DecodeStatus s) noexcept {
 }
 
 std::size_t encode_datagram(const Frame& f, double timestamp_s, std::span<std::uint8_t> out) noexcept {
-  if (!f.valid()) return 0;
+  if (!f.valid() || f.error) return 0;
   Writer w(out);
   w.byte(0x8b);  // fixmap, 11 entries, in python-can's order
   w.str("timestamp");
@@ -231,9 +231,9 @@ std::size_t encode_datagram(const Frame& f, double timestamp_s, std::span<std::u
   w.str("is_fd");
   w.boolean(f.fd);
   w.str("bitrate_switch");
-  w.boolean(false);
+  w.boolean(f.brs);
   w.str("error_state_indicator");
-  w.boolean(false);
+  w.boolean(f.esi);
   return w.ok() ? w.size() : 0;
 }
 
@@ -281,6 +281,8 @@ DecodeStatus decode_datagram(std::span<const std::uint8_t> in, Frame& out) noexc
       if (key_is(k, "is_error_frame")) error_frame = v.b;
       if (key_is(k, "is_fd")) f.fd = v.b;
       if ((key_is(k, "bitrate_switch") || key_is(k, "error_state_indicator")) && v.b) fd_only_flag = true;
+      if (key_is(k, "bitrate_switch")) f.brs = v.b;
+      if (key_is(k, "error_state_indicator")) f.esi = v.b;
     } else if (key_is(k, "channel")) {
       // nil, a string or an int: ignored
     } else if (key_is(k, "dlc")) {

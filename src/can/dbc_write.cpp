@@ -47,7 +47,7 @@ std::string write_dbc(const Database& db) {
     for (const auto& s : m.signals) {
       std::string mux;
       if (s.mux == MuxRole::multiplexor) mux = " M";
-      if (s.mux == MuxRole::multiplexed) mux = fmt::format(" m{}", s.mux_value);
+      if (s.mux == MuxRole::multiplexed) mux = fmt::format(" m{}{}", s.mux_value, s.mux_switch ? "M" : "");
       out += fmt::format(" SG_ {}{} : {}|{}@{}{} ({},{}) [{}|{}] {} ", s.name, mux, s.start_bit, s.length,
                          s.byte_order == ByteOrder::intel ? 1 : 0, s.is_signed ? '-' : '+',
                          format_double(s.factor), format_double(s.offset), format_double(s.minimum),
@@ -91,6 +91,14 @@ std::string write_dbc(const Database& db) {
     for (const auto& s : m.signals)
       if (s.value_type != ValueType::integer)
         out += fmt::format("SIG_VALTYPE_ {} {} : {};\n", m.dbc_id(), s.name, static_cast<int>(s.value_type));
+  for (const auto& m : db.messages)
+    for (const auto& s : m.signals)
+      if (!s.multiplexor.empty()) {
+        out += fmt::format("SG_MUL_VAL_ {} {} {}", m.dbc_id(), s.name, s.multiplexor);
+        for (std::size_t i = 0; i < s.mux_ranges.size(); ++i)
+          out += fmt::format("{} {}-{}", i ? "," : "", s.mux_ranges[i].lo, s.mux_ranges[i].hi);
+        out += ";\n";
+      }
   return out;
 }
 

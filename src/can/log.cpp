@@ -9,6 +9,7 @@
 
 #include "lash/io/atomic_file.hpp"
 #include "lash/io/error.hpp"
+#include "log_formats.hpp"
 
 namespace lash::can {
 namespace {
@@ -54,20 +55,27 @@ std::optional<Frame> parse_frame_text(std::string_view text, std::string& error)
       return std::nullopt;
     }
     f.extended = id_text.size() == 8;
-    if (f.extended && f.id > 0x1FFFFFFFu) {
-      error = "29-bit id out of range (error frames are not supported): '" + std::string(id_text) + "'";
+    if (f.extended && (f.id & 0x20000000u) && !(f.id & 0xC0000000u)) {  // SocketCAN CAN_ERR_FLAG
+      f.error = true;
+      f.extended = false;
+      f.id &= 0x1FFFFFFFu;
+    } else if (f.extended && f.id > 0x1FFFFFFFu) {
+      error = "29-bit id out of range: '" + std::string(id_text) + "'";
       return std::nullopt;
     }
-    if (!f.extended && f.id > 0x7FFu) {
+    if (!f.extended && !f.error && f.id > 0x7FFu) {
       error = "11-bit id out of range: '" + std::string(id_text) + "'";
       return std::nullopt;
     }
     if (!rest.empty() && rest.front() == '#') {  // CAN FD: ##<flags><data>
-      if (rest.size() < 2 || hex_value(rest[1]) < 0) {
-        error = "CAN FD frame needs a flags digit after '##'";
+      const int flags = rest.size() >= 2 ? hex_value(rest[1]) : -1;
+      if (flags < 0 || flags > 3) {
+        error = "CAN FD frame needs a flags digit 0-3 (1 = BRS, 2 = ESI) after '##'";
         return std::nullopt;
       }
       f.fd = true;
+      f.brs = (flags & 1) != 0;
+      f.esi = (flags & 2) != 0;
       rest.remove_prefix(2);
     }
     if (!f.fd && !rest.empty() && (rest.front() == 'R' || rest.front() == 'r')) {
@@ -100,6 +108,10 @@ std::optional<Frame> parse_frame_text(std::string_view text, std::string& error)
       f.data[n++] = static_cast<std::uint8_t>(hex_value(rest[i]) * 16 + hex_value(rest[i + 1]));
       i += 2;
     }
+    if (f.fd && n > 8 && n != 12 && n != 16 && n != 20 && n != 24 && n != 32 && n != 48 && n != 64) {
+      error = fmt::format("{} data bytes is no CAN FD length", n);
+      return std::nullopt;
+    }
     f.len = static_cast<std::uint8_t>(n);
     return f;
   } catch (...) {
@@ -110,15 +122,19 @@ std::optional<Frame> parse_frame_text(std::string_view text, std::string& error)
 
 std::string format_frame_text(const Frame& f) {
   std::string out;
-  const int digits = f.extended ? 8 : 3;
-  for (int i = digits - 1; i >= 0; --i) out.push_back(kHex[(f.id >> (4 * i)) & 0xF]);
+  const int digits = f.extended || f.error ? 8 : 3;
+  const std::uint32_t id = f.error ? (f.id | 0x20000000u) : f.id;
+  for (int i = digits - 1; i >= 0; --i) out.push_back(kHex[(id >> (4 * i)) & 0xF]);
   out.push_back('#');
   if (f.remote) {
     out.push_back('R');
     if (f.len > 0 && f.len <= 8) out.push_back(static_cast<char>('0' + f.len));
     return out;
   }
-  if (f.fd) out += "#0";
+  if (f.fd) {
+    out.push_back('#');
+    out.push_back(kHex[(f.brs ? 1 : 0) | (f.esi ? 2 : 0)]);
+  }
   for (std::size_t i = 0; i < f.len && i < f.data.size(); ++i) {
     out.push_back(kHex[f.data[i] >> 4]);
     out.push_back(kHex[f.data[i] & 0xF]);
@@ -126,13 +142,160 @@ std::string format_frame_text(const Frame& f) {
   return out;
 }
 
+namespace {
+
+/// "(seconds.fraction)" → seconds; false on bad text.
+bool parse_seconds(std::string_view num, double& out, std::string& error) {
+  const auto dot = num.find('.');
+  if (dot == std::string_view::npos || dot == 0 || dot + 1 >= num.size()) {
+    error = "timestamp must look like (seconds.microseconds)";
+    return false;
+  }
+  std::uint64_t sec = 0;
+  for (std::size_t k = 0; k < dot; ++k) {
+    if (num[k] < '0' || num[k] > '9' || sec > 100000000000ull) {
+      error = "bad seconds in timestamp";
+      return false;
+    }
+    sec = sec * 10 + static_cast<std::uint64_t>(num[k] - '0');
+  }
+  const std::string_view frac = num.substr(dot + 1);
+  if (frac.size() > 9) {
+    error = "too many fraction digits in timestamp";
+    return false;
+  }
+  std::uint64_t ns = 0;
+  for (std::size_t k = 0; k < 9; ++k) {
+    std::uint64_t d = 0;
+    if (k < frac.size()) {
+      if (frac[k] < '0' || frac[k] > '9') {
+        error = "bad fraction in timestamp";
+        return false;
+      }
+      d = static_cast<std::uint64_t>(frac[k] - '0');
+    }
+    ns = ns * 10 + d;
+  }
+  out = static_cast<double>(sec) + static_cast<double>(ns) * 1e-9;
+  return true;
+}
+
+/// Days since 1970-01-01 of a proleptic Gregorian date (Howard Hinnant's algorithm).
+std::int64_t days_from_civil(std::int64_t y, unsigned m, unsigned d) {
+  y -= m <= 2;
+  const std::int64_t era = (y >= 0 ? y : y - 399) / 400;
+  const auto yoe = static_cast<unsigned>(y - era * 400);
+  const unsigned doy = (153 * (m + (m > 2 ? -3 : 9)) + 2) / 5 + d - 1;
+  const unsigned doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
+  return era * 146097 + static_cast<std::int64_t>(doe) - 719468;
+}
+
+/// "2020-12-19" "12:04:45.485261" (UTC) → seconds since the epoch.
+bool parse_date_time(std::string_view date, std::string_view time, double& out, std::string& error) {
+  int y = 0, mo = 0, d = 0, h = 0, mi = 0;
+  if (std::sscanf(std::string(date).c_str(), "%4d-%2d-%2d", &y, &mo, &d) != 3 || mo < 1 || mo > 12 || d < 1 || d > 31) {
+    error = "bad date in timestamp";
+    return false;
+  }
+  const auto c1 = time.find(':');
+  const auto c2 = time.find(':', c1 == std::string_view::npos ? 0 : c1 + 1);
+  if (c1 == std::string_view::npos || c2 == std::string_view::npos) {
+    error = "bad time in timestamp";
+    return false;
+  }
+  h = std::atoi(std::string(time.substr(0, c1)).c_str());
+  mi = std::atoi(std::string(time.substr(c1 + 1, c2 - c1 - 1)).c_str());
+  double sec = 0;
+  if (!parse_seconds(time.substr(c2 + 1), sec, error)) return false;
+  out = static_cast<double>(days_from_civil(y, static_cast<unsigned>(mo), static_cast<unsigned>(d)) * 86400 + h * 3600 + mi * 60) + sec;
+  return true;
+}
+
+/// candump's default output: [(time)] iface ID [n] B0 B1 … [ERRORFRAME | remote request].
+std::optional<LogEntry> parse_plain_line(const std::string_view* p, std::size_t n, std::string& error) {
+  std::size_t k = 0;
+  double t = 0;
+  if (n > 0 && p[0].front() == '(') {
+    if (p[0].back() == ')') {
+      if (!parse_seconds(p[0].substr(1, p[0].size() - 2), t, error)) return std::nullopt;
+      k = 1;
+    } else if (n > 1 && p[1].back() == ')') {
+      if (!parse_date_time(p[0].substr(1), p[1].substr(0, p[1].size() - 1), t, error)) return std::nullopt;
+      k = 2;
+    } else {
+      error = "bad timestamp";
+      return std::nullopt;
+    }
+  }
+  if (n < k + 3) {
+    error = "expected '[(time)] iface ID [n] data' or '(time) iface ID#DATA'";
+    return std::nullopt;
+  }
+  LogEntry e;
+  e.interface = std::string(p[k]);
+  const std::string_view idt = p[k + 1];
+  std::uint32_t id = 0;
+  if ((idt.size() != 3 && idt.size() != 8) || !parse_hex_u32(idt, id)) {
+    error = "bad id '" + std::string(idt) + "' (3 or 8 hex digits)";
+    return std::nullopt;
+  }
+  Frame& f = e.frame;
+  f.extended = idt.size() == 8;
+  const std::string_view lt = p[k + 2];
+  const bool fd = lt.size() >= 4 && lt[0] == '[' && lt[1] == '[';
+  const std::string_view ln = fd ? lt.substr(2, lt.size() - 4) : lt.substr(1, lt.size() - 2);
+  unsigned len = 0;
+  if (lt.size() < 3 || lt.front() != '[' || lt.back() != ']' || ln.empty() || ln.size() > 2 ||
+      std::sscanf(std::string(ln).c_str(), "%u", &len) != 1) {
+    error = "bad length field '" + std::string(lt) + "'";
+    return std::nullopt;
+  }
+  std::size_t b = k + 3;
+  const bool errorframe = n > 0 && p[n - 1] == "ERRORFRAME";
+  const bool remote = n >= 2 && p[n - 1] == "request" && p[n - 2] == "remote";
+  const std::size_t end = errorframe ? n - 1 : remote ? n - 2 : n;
+  if (errorframe) {
+    f.error = true;
+    f.extended = false;
+    id &= 0x1FFFFFFFu;
+  } else if (f.extended ? id > 0x1FFFFFFFu : id > 0x7FFu) {
+    error = "id out of range: '" + std::string(idt) + "'";
+    return std::nullopt;
+  }
+  f.id = id;
+  f.fd = fd;
+  f.remote = remote;
+  if (len > (fd ? Frame::kMaxFdLen : Frame::kMaxClassicLen)) {
+    error = fmt::format("length {} exceeds {} bytes", len, fd ? Frame::kMaxFdLen : Frame::kMaxClassicLen);
+    return std::nullopt;
+  }
+  if (!remote && end - b != len) {
+    error = fmt::format("length says {} bytes, the line has {}", len, end - b);
+    return std::nullopt;
+  }
+  for (std::size_t i = 0; b < end; ++b, ++i) {
+    std::uint32_t v = 0;
+    if (p[b].size() != 2 || !parse_hex_u32(p[b], v)) {
+      error = "bad data byte '" + std::string(p[b]) + "'";
+      return std::nullopt;
+    }
+    f.data[i] = static_cast<std::uint8_t>(v);
+  }
+  f.len = static_cast<std::uint8_t>(len);
+  f.timestamp_s = t;
+  return e;
+}
+
+}  // namespace
+
 std::optional<LogEntry> parse_log_line(std::string_view line, std::string& error) noexcept {
   try {
     while (!line.empty() && (line.back() == '\r' || line.back() == '\n' || line.back() == ' ' || line.back() == '\t'))
       line.remove_suffix(1);
     while (!line.empty() && (line.front() == ' ' || line.front() == '\t')) line.remove_prefix(1);
     // Split on blanks.
-    std::string_view parts[5];
+    constexpr std::size_t kMax = 72;
+    std::string_view parts[kMax];
     std::size_t n = 0;
     std::size_t i = 0;
     while (i < line.size()) {
@@ -140,13 +303,14 @@ std::optional<LogEntry> parse_log_line(std::string_view line, std::string& error
       if (i >= line.size()) break;
       std::size_t j = i;
       while (j < line.size() && line[j] != ' ' && line[j] != '\t') ++j;
-      if (n == 5) {
-        error = "too many fields (expected '(time) iface ID#DATA')";
+      if (n == kMax) {
+        error = "too many fields";
         return std::nullopt;
       }
       parts[n++] = line.substr(i, j - i);
       i = j;
     }
+    if (n >= 3 && parts[2].find('#') == std::string_view::npos) return parse_plain_line(parts, n, error);
     if (n == 4 && (parts[3] == "R" || parts[3] == "T" || parts[3] == "r" || parts[3] == "t")) n = 3;
     if (n != 3) {
       error = "expected '(seconds.microseconds) iface ID#DATA'";
@@ -157,37 +321,8 @@ std::optional<LogEntry> parse_log_line(std::string_view line, std::string& error
       error = "timestamp must look like (seconds.microseconds)";
       return std::nullopt;
     }
-    const std::string_view num = ts.substr(1, ts.size() - 2);
-    const auto dot = num.find('.');
-    if (dot == std::string_view::npos || dot == 0 || dot + 1 >= num.size()) {
-      error = "timestamp must look like (seconds.microseconds)";
-      return std::nullopt;
-    }
-    std::uint64_t sec = 0;
-    for (std::size_t k = 0; k < dot; ++k) {
-      if (num[k] < '0' || num[k] > '9' || sec > 100000000000ull) {
-        error = "bad seconds in timestamp";
-        return std::nullopt;
-      }
-      sec = sec * 10 + static_cast<std::uint64_t>(num[k] - '0');
-    }
-    const std::string_view frac = num.substr(dot + 1);
-    if (frac.size() > 9) {
-      error = "too many fraction digits in timestamp";
-      return std::nullopt;
-    }
-    std::uint64_t ns = 0;
-    for (std::size_t k = 0; k < 9; ++k) {
-      std::uint64_t d = 0;
-      if (k < frac.size()) {
-        if (frac[k] < '0' || frac[k] > '9') {
-          error = "bad fraction in timestamp";
-          return std::nullopt;
-        }
-        d = static_cast<std::uint64_t>(frac[k] - '0');
-      }
-      ns = ns * 10 + d;
-    }
+    double t = 0;
+    if (!parse_seconds(ts.substr(1, ts.size() - 2), t, error)) return std::nullopt;
     LogEntry e;
     e.interface = std::string(parts[1]);
     std::string ferr;
@@ -197,7 +332,7 @@ std::optional<LogEntry> parse_log_line(std::string_view line, std::string& error
       return std::nullopt;
     }
     e.frame = *f;
-    e.frame.timestamp_s = static_cast<double>(sec) + static_cast<double>(ns) * 1e-9;
+    e.frame.timestamp_s = t;
     return e;
   } catch (...) {
     error = "out of memory";
@@ -214,10 +349,11 @@ std::string format_log_line(const Frame& frame, std::string_view interface) {
     sec += 1;
     us -= 1000000;
   }
-  return fmt::format("({}.{:06d}) {} {}", sec, us, interface, format_frame_text(frame));
+  return fmt::format("({}.{:06d}) {} {}", sec, us, interface.empty() ? std::string_view("can0") : interface,
+                     format_frame_text(frame));
 }
 
-std::vector<LogEntry> parse_log(std::string_view text, const std::string& file) {
+std::vector<LogEntry> parse_log(std::string_view text, const std::string& file, LogReadReport* report) {
   std::vector<LogEntry> out;
   int lineno = 0;
   std::size_t pos = 0;
@@ -233,24 +369,67 @@ std::vector<LogEntry> parse_log(std::string_view text, const std::string& file) 
     }
     std::string error;
     auto e = parse_log_line(line, error);
-    if (!e) throw InputError(file, lineno, "candump line", error);
-    out.push_back(std::move(*e));
+    if (e && !e->frame.valid()) {
+      error = "invalid frame";
+      e.reset();
+    }
+    if (!e) {
+      if (!report) throw InputError(file, lineno, "candump line", error);
+      ++report->dropped;
+      report->problems.push_back(fmt::format("{}:{}: {}", file, lineno, error));
+    } else {
+      out.push_back(std::move(*e));
+    }
     if (nl == text.size()) break;
   }
   return out;
 }
 
-std::vector<LogEntry> read_log(const std::filesystem::path& path) {
+LogFormat log_format_of(const std::filesystem::path& path) noexcept {
+  std::string ext = path.extension().string();
+  for (auto& c : ext) c = static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
+  if (ext == ".asc") return LogFormat::asc;
+  if (ext == ".blf") return LogFormat::blf;
+  if (ext == ".trc") return LogFormat::trc;
+  return LogFormat::candump;
+}
+
+const char* to_string(LogFormat f) noexcept {
+  switch (f) {
+    case LogFormat::asc: return "Vector ASC";
+    case LogFormat::blf: return "Vector BLF";
+    case LogFormat::trc: return "PEAK TRC";
+    default: return "candump";
+  }
+}
+
+std::string read_file_bytes(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path.string(), 0, "", "cannot open log file for reading");
   std::ostringstream ss;
   ss << in.rdbuf();
-  return parse_log(ss.str(), path.string());
+  return ss.str();
+}
+
+std::vector<LogEntry> read_log(const std::filesystem::path& path, LogReadReport* report) {
+  const std::string bytes = read_file_bytes(path);
+  switch (log_format_of(path)) {
+    case LogFormat::asc: return detail::parse_asc(bytes, path.string(), report);
+    case LogFormat::blf: return detail::parse_blf(bytes, path.string(), report);
+    case LogFormat::trc: return detail::parse_trc(bytes, path.string(), report);
+    default: return parse_log(bytes, path.string(), report);
+  }
 }
 
 void write_log(const std::filesystem::path& path, const std::vector<LogEntry>& entries) {
   AtomicFile f(path);
-  for (const auto& e : entries) f.stream() << format_log_line(e.frame, e.interface) << '\n';
+  switch (log_format_of(path)) {
+    case LogFormat::asc: detail::write_asc(f.stream(), entries); break;
+    case LogFormat::blf: detail::write_blf(f.stream(), entries); break;
+    case LogFormat::trc: detail::write_trc(f.stream(), entries); break;
+    default:
+      for (const auto& e : entries) f.stream() << format_log_line(e.frame, e.interface) << '\n';
+  }
   f.commit();
 }
 

@@ -5,6 +5,7 @@
 
 #include "lash/identify/estimators.hpp"
 #include "lash/io/error.hpp"
+#include "lash/metrics/first_order.hpp"
 #include "lash/signals/rng.hpp"
 
 namespace lash {
@@ -76,8 +77,8 @@ FirstOrderDeadzoneModel identify_online_on_rig(const rigs::PilotValveRigParams& 
   if (!p.identified || !(p.a1 < 0 && p.a1 > -1) || !(p.b1 > 0))
     throw RunError("online estimator did not identify the right side");
   FirstOrderDeadzoneModel m;
-  m.gain_kPa_per_mA = p.b1 / (1.0 + p.a1);
-  m.tau_s = -dt_s / std::log(-p.a1);
+  m.gain_kPa_per_mA = static_gain(p.a1, p.b1);
+  m.tau_s = time_constant_s(p.a1, dt_s);
   m.deadzone_mA = p.c;
   return m;
 }

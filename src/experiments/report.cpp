@@ -124,6 +124,8 @@ std::string summary_json(const Campaign& c, const Summary& s, const std::vector<
   j["share_good"] = s.share_good;
   j["median_nrmse"] = num(s.median_nrmse);
   j["worst_nrmse"] = num(s.worst_nrmse);
+  j["median_nrmse_pct"] = num(100.0 * s.median_nrmse);  // the same in percent, for a person
+  j["worst_nrmse_pct"] = num(100.0 * s.worst_nrmse);
   if (!results.empty()) {
     j["median_run"] = label(results[s.median_index].spec);
     j["worst_run"] = label(results[s.worst_index].spec);
@@ -131,7 +133,8 @@ std::string summary_json(const Campaign& c, const Summary& s, const std::vector<
   auto& pw = j["per_waveform"];
   pw = nlohmann::json::object();
   for (const auto& w : s.per_waveform)
-    pw[w.waveform] = {{"runs", w.runs}, {"good", w.good}, {"share_good", w.share_good}, {"median_nrmse", num(w.median_nrmse)}};
+    pw[w.waveform] = {{"runs", w.runs}, {"good", w.good}, {"share_good", w.share_good}, {"median_nrmse", num(w.median_nrmse)},
+                        {"median_nrmse_pct", num(100.0 * w.median_nrmse)}};
   j["sides_identified"] = s.sides_identified;
   j["sides_total"] = s.sides_total;
   j["identified_with_cl_gt_cr"] = s.unphysical_reported;

@@ -20,6 +20,7 @@ SideParams read_truth(TomlTable t) {
   p.c = t.number_or("c", p.c);
   p.d = t.number_or("d", p.d);
   p.identified = true;
+  p.reason = Reason::none;
   t.finish();
   return p;
 }
@@ -134,11 +135,6 @@ ScenarioRun run_scenario(const ScenarioSpec& s, std::uint64_t seed) {
                              : std::numeric_limits<double>::quiet_NaN();
   run.nrmse = nrmse(t, y, ysim, s.nrmse_t0_s, s.nrmse_t1_s);
   return run;
-}
-
-double error_percent(double estimate, double truth) noexcept {
-  if (!std::isfinite(estimate)) return std::numeric_limits<double>::quiet_NaN();
-  return 100.0 * std::fabs(estimate - truth) / std::fabs(truth);
 }
 
 }  // namespace lash

@@ -9,44 +9,22 @@
 #include <mutex>
 #include <thread>
 
+#include "lash/metrics/error.hpp"
+#include "lash/metrics/first_order.hpp"
+#include "lash/metrics/fit.hpp"
 #include "lash/plant/simulate.hpp"
 
 namespace lash::sweep {
 namespace {
 
-/// NRMSE accumulator over a window of sample indices [k0, k1].
+/// NRMSE over a window of sample indices [k0, k1].
 struct Score {
   std::size_t k0 = 0, k1 = 0;
-  double sum_sq = 0.0, max_abs = 0.0;
-  std::size_t n = 0;
+  NrmseAccumulator acc;
   void add(std::size_t k, double y, double ysim) noexcept {
-    if (k < k0 || k > k1) return;
-    const double e = y - ysim;
-    sum_sq += std::isfinite(e) ? e * e : std::numeric_limits<double>::infinity();
-    max_abs = std::max(max_abs, std::fabs(y));
-    ++n;
+    if (k >= k0 && k <= k1) acc.add(y, ysim);
   }
-  double nrmse() const noexcept {
-    if (n == 0 || max_abs == 0.0) return kNaN;
-    return std::sqrt(sum_sq / static_cast<double>(n)) / max_abs;
-  }
-};
-
-/// Range of v(k−1) over the samples on which each side's RLS updated (excitation check).
-struct Excitation {
-  PerSide<detail::ValueRange> range{};
-  PerSide<std::uint64_t> last{};
-  template <class Est>
-  void observe(const Est& est, double v_prev) noexcept {
-    for (Side s : {Side::right, Side::left}) {
-      const auto u = est.updates(s);
-      if (u != last[s]) {
-        range[s].add(v_prev);
-        last[s] = u;
-      }
-    }
-  }
-  bool exciting(Side s) const noexcept { return range[s].several(); }
+  double nrmse() const noexcept { return acc.value(); }
 };
 
 SignalSpec signal_of(const Campaign& c, const RunSpec& r) {
@@ -62,8 +40,10 @@ SignalSpec signal_of(const Campaign& c, const RunSpec& r) {
 
 std::size_t index_at(double t_s, double dt_s) { return static_cast<std::size_t>(std::llround(t_s / dt_s)); }
 
+/// Per side what the estimator identified, with its verdict (verdict.hpp): the sweep reports
+/// the estimator's decision and never re-decides it.
 template <class Est>
-void fill_sides(RunResult& out, const Est& est, const Excitation& ex, double dt_s, bool check_excitation) {
+void fill_sides(RunResult& out, const Est& est, double dt_s) {
   for (Side s : {Side::right, Side::left}) {
     const SideParams p = est.params(s);
     SideResult& r = out.side[s];
@@ -71,37 +51,12 @@ void fill_sides(RunResult& out, const Est& est, const Excitation& ex, double dt_
     r.a1 = p.a1;
     r.b1 = p.b1;
     r.c = p.c;
-    r.identified = p.identified && std::isfinite(p.a1) && std::isfinite(p.b1) && std::isfinite(p.c);
-    if (std::isfinite(p.a1) && std::isfinite(p.b1)) {
-      r.gain = p.b1 / (1.0 + p.a1);
-      r.tau_s = (p.a1 < 0.0 && p.a1 > -1.0) ? -dt_s / std::log(-p.a1) : kNaN;
-    }
-    if (r.identified && check_excitation && !ex.exciting(s)) {
-      r.identified = false;
-      r.rejected = "input not exciting";
-    }
+    r.gain = static_gain(p.a1, p.b1);
+    r.tau_s = time_constant_s(p.a1, dt_s);
+    const Reason why = est.verdict(s);
+    r.identified = why == Reason::none;
+    r.rejected = r.identified ? "" : to_string(why);
   }
-  // Physical sense (thesis §1.6.1): a deadzone from Coulomb friction, spring pretension or spool
-  // overlap contains zero: c_l ≤ 0 ≤ c_r. A side that violates it is not presented as identified.
-  SideResult& R = out.side.right;
-  SideResult& L = out.side.left;
-  if (R.identified && R.c < 0.0) {
-    R.identified = false;
-    R.rejected = "unphysical deadzone";
-  }
-  if (L.identified && L.c > 0.0) {
-    L.identified = false;
-    L.rejected = "unphysical deadzone";
-  }
-  if (R.identified && L.identified && L.c > R.c) {
-    R.identified = L.identified = false;
-    R.rejected = L.rejected = "unphysical deadzone";
-  }
-}
-
-double rel_err(double est, double truth) {
-  if (!std::isfinite(est) || !std::isfinite(truth) || truth == 0.0) return std::numeric_limits<double>::infinity();
-  return std::fabs(est / truth - 1.0);
 }
 
 void score_params(RunResult& out, bool compare_tau) {
@@ -110,11 +65,11 @@ void score_params(RunResult& out, bool compare_tau) {
     const SideResult& r = out.side[s];
     if (!r.identified) continue;
     const auto& t = out.truth.side[s];
-    worst = std::max(worst, rel_err(r.gain, t.gain));
-    worst = std::max(worst, rel_err(r.c, t.c));
-    if (compare_tau) worst = std::max(worst, rel_err(r.tau_s, t.tau_s));
+    worst = std::max(worst, relative_error(r.gain, t.gain));
+    worst = std::max(worst, relative_error(r.c, t.c));
+    if (compare_tau) worst = std::max(worst, relative_error(r.tau_s, t.tau_s));
   }
-  if (out.d_identified) worst = std::max(worst, rel_err(out.d, out.truth.d));
+  if (out.d_identified) worst = std::max(worst, relative_error(out.d, out.truth.d));
   out.param_error = worst < 0.0 ? kNaN : worst;
 }
 
@@ -122,21 +77,18 @@ void score_params(RunResult& out, bool compare_tau) {
 /// then the rig advances over [t_k, t_{k+1}] with v(k) held and returns y(k+1).
 template <class Est, class Rig, class Measure, class Simulated>
 void drive(Est& est, Rig& rig, Measure measure, Simulated simulated, Signal& sig, std::size_t n, Score& score,
-           Excitation& ex, double dt_s, std::vector<TraceRow>* trace) {
+           double dt_s, std::vector<TraceRow>* trace) {
   auto y = rig.initial_output();
-  double v_prev = 0.0;
   if (trace) trace->reserve(trace->size() + n);
   for (std::size_t k = 0; k < n; ++k) {
     const double v = sig.next();
     const auto [y_est, y_scored] = measure(y);
     est.step(v, y_est);
-    ex.observe(est, v_prev);
     const double y_sim = simulated(est);
     score.add(k, y_scored, y_sim);
     if (trace)
       trace->push_back(TraceRow{static_cast<double>(k) * dt_s, v, y_scored, y_sim,
                                 {est.params(Side::right), est.params(Side::left)}});
-    v_prev = v;
     y = rig.step(v);
   }
 }
@@ -147,13 +99,12 @@ struct SimOut {
 };
 
 template <class Est>
-RunResult finish(const Campaign& c, const RunSpec& r, const Est& est, const Score& score, const Excitation& ex,
-                 bool check_excitation) {
+RunResult finish(const Campaign& c, const RunSpec& r, const Est& est, const Score& score) {
   RunResult out;
   out.spec = r;
   out.nrmse = score.nrmse();
-  out.max_abs_y = score.max_abs;
-  fill_sides(out, est, ex, c.dt_s, check_excitation);
+  out.max_abs_y = score.acc.max_abs;
+  fill_sides(out, est, c.dt_s);
   return out;
 }
 
@@ -161,16 +112,16 @@ RunResult finish(const Campaign& c, const RunSpec& r, const Est& est, const Scor
 /// (load_campaign admits no other model for these rigs).
 template <class Rig>
 RunResult run_deadzone_model(const Campaign& c, const RunSpec& r, Rig& rig, Signal& sig, std::size_t n, Score& score,
-                             Excitation& ex, std::vector<TraceRow>* trace) {
+                             std::vector<TraceRow>* trace) {
   auto same = [](double y) { return std::pair<double, double>{y, y}; };
   if (c.estimator.model == ModelKind::output_deadzone) {
     OutputDeadzoneEstimator est(c.estimator);
-    drive(est, rig, same, SimOut{}, sig, n, score, ex, c.dt_s, trace);
-    return finish(c, r, est, score, ex, true);
+    drive(est, rig, same, SimOut{}, sig, n, score, c.dt_s, trace);
+    return finish(c, r, est, score);
   }
   InputDeadzoneEstimator est(c.estimator);
-  drive(est, rig, same, SimOut{}, sig, n, score, ex, c.dt_s, trace);
-  return finish(c, r, est, score, ex, true);
+  drive(est, rig, same, SimOut{}, sig, n, score, c.dt_s, trace);
+  return finish(c, r, est, score);
 }
 
 }  // namespace
@@ -181,20 +132,19 @@ RunResult run_one(const Campaign& c, const RunSpec& r, std::vector<TraceRow>* tr
   Score score;
   score.k0 = index_at(c.window_start_s, c.dt_s);
   score.k1 = std::min(n - 1, index_at(c.window_end_s, c.dt_s));
-  Excitation ex;
   const EstimatorConfig& ec = c.estimator;
   RunResult out;
   switch (c.rig.kind) {
     case rigs::RigKind::motor_cart: {
       rigs::MotorCart rig(c.rig.motor_cart, c.dt_s, r.seed);
-      out = run_deadzone_model(c, r, rig, sig, n, score, ex, trace);
+      out = run_deadzone_model(c, r, rig, sig, n, score, trace);
       out.truth = rig.effective();
       score_params(out, true);
       break;
     }
     case rigs::RigKind::pilot_valve: {
       rigs::PilotValveRig rig(c.rig.pilot_valve, c.dt_s, r.seed);
-      out = run_deadzone_model(c, r, rig, sig, n, score, ex, trace);
+      out = run_deadzone_model(c, r, rig, sig, n, score, trace);
       out.truth = c.rig.pilot_valve.effective(c.dt_s, 0.0);
       score_params(out, false);
       break;
@@ -215,10 +165,10 @@ RunResult run_one(const Campaign& c, const RunSpec& r, std::vector<TraceRow>* tr
         return vel;
       };
       CoupledCartsEstimator est(ec);
-      drive(est, rig, pos_vel, sim_vel, sig, n, score, ex, c.dt_s, trace);
-      out = finish(c, r, est, score, ex, false);
+      drive(est, rig, pos_vel, sim_vel, sig, n, score, c.dt_s, trace);
+      out = finish(c, r, est, score);
       out.d = est.deadband();
-      out.d_identified = std::isfinite(out.d) && out.d >= 0.0;
+      out.d_identified = est.deadband_reason() == Reason::none;
       out.truth = rig.effective();
       score_params(out, true);
       break;

@@ -1,31 +1,63 @@
 #include "lash/hil/nodes.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include "lash/rt/periodic.hpp"
 
 namespace lash::hil {
 
-bool SeqTracker::on_frame(std::uint16_t counter) noexcept {
-  ++received;
-  ++in_step;
-  if (!have) {
-    have = true;
-    last = counter;
-    return true;
+namespace {
+
+void validate(const E2EConfig& e, std::uint32_t counter_bits, const char* who) {
+  const std::string w(who);
+  if (e.max_counter_delta < 1 || e.max_counter_delta >= (1u << (counter_bits - 1)))
+    throw std::invalid_argument(w + ": e2e.max_counter_delta must be in 1.." + std::to_string((1u << (counter_bits - 1)) - 1) +
+                                " for a " + std::to_string(counter_bits) + "-bit counter");
+  if (e.sync_frames < 1) throw std::invalid_argument(w + ": e2e.sync_frames must be >= 1");
+  if (e.recovery_frames < 1) throw std::invalid_argument(w + ": e2e.recovery_frames must be >= 1");
+  if (!(e.ramp_mA_per_s > 0) || !std::isfinite(e.ramp_mA_per_s))
+    throw std::invalid_argument(w + ": e2e.ramp_mA_per_s must be > 0 [mA/s]");
+}
+
+SeqTracker make_tracker(std::uint32_t bits, const E2EConfig& e) {
+  SeqTracker t;
+  t.bits = bits;
+  t.max_delta = e.max_counter_delta;
+  t.sync_frames = e.sync_frames;
+  return t;
+}
+
+}  // namespace
+
+const char* to_string(NodeState s) noexcept {
+  switch (s) {
+    case NodeState::startup: return "startup";
+    case NodeState::connected: return "connected";
+    case NodeState::running: return "running";
+    case NodeState::degraded: return "degraded";
+    case NodeState::safe: return "safe";
+    case NodeState::failed: return "failed";
   }
-  const std::uint16_t d = counter_delta(last, counter);
-  if (d == 0) {
-    ++duplicates;
-    return false;
+  return "?";
+}
+
+const char* to_string(NodeEventKind k) noexcept {
+  switch (k) {
+    case NodeEventKind::connect_sent: return "ccp_connect_sent";
+    case NodeEventKind::connected: return "ccp_connected";
+    case NodeEventKind::input_valid: return "input_valid_running";
+    case NodeEventKind::input_implausible: return "input_implausible_degraded";
+    case NodeEventKind::input_stale: return "input_stale_degraded";
+    case NodeEventKind::ramp_done: return "ramp_done_safe_state";
+    case NodeEventKind::sensor_timeout: return "sensor_timeout_safe_state";
+    case NodeEventKind::input_recovered: return "input_recovered";
+    case NodeEventKind::input_resumed: return "input_resumed";
+    case NodeEventKind::dto_timeout: return "dto_timeout";
   }
-  if (d >= 1024) {
-    ++resyncs;  // a restarted peer, or a frame older than anything plausible
-  } else {
-    lost += d - 1u;
-  }
-  last = counter;
-  return true;
+  return "?";
 }
 
 // ----------------------------------------------------------------------------- slave
@@ -33,6 +65,14 @@ bool SeqTracker::on_frame(std::uint16_t counter) noexcept {
 SlaveNode::SlaveNode(const BenchLayout& layout, SlaveConfig config)
     : layout_(layout), cfg_(std::move(config)), plant_(cfg_.plant) {
   if (cfg_.dto_reply.empty()) throw std::invalid_argument("slave: the recorded DTO reply is empty");
+  validate(cfg_.e2e, layout_.command_counter_bits(), "slave");
+  if (cfg_.stale_periods < 1) throw std::invalid_argument("slave: stale_periods must be >= 1");
+  if (!std::isfinite(cfg_.current_min_mA) || !std::isfinite(cfg_.current_max_mA) ||
+      !(cfg_.current_min_mA < cfg_.current_max_mA))
+    throw std::invalid_argument("slave: the current driver's range must be finite with min < max [mA]");
+  cmd_ = make_tracker(layout_.command_counter_bits(), cfg_.e2e);
+  ramp_step_mA_ = cfg_.e2e.ramp_mA_per_s * cfg_.plant.dt_s;
+  current_mA_ = command_mA_ = cfg_.current_min_mA;
   plant_.reset(0.0);
   log_.resize(cfg_.log_capacity);
 }
@@ -55,25 +95,41 @@ bool SlaveNode::wait_connect(can::Bus& bus, std::chrono::nanoseconds timeout) {
     if (!f) return false;
     if (layout_.is_connect(*f)) {
       reply_dto(bus);
+      if (state_ == SlaveState::startup) go(SlaveState::connected, NodeEventKind::connected, 0.0);
       return true;
     }
     ++ignored_;
   }
 }
 
+void SlaveNode::go(SlaveState to, NodeEventKind why, double now_s) noexcept {
+  events_.add(NodeEvent{step_, now_s, why, state_, to});
+  state_ = to;
+}
+
 void SlaveNode::step(can::Bus& bus, double now_s) noexcept {
-  (void)now_s;
-  bool fresh = false;
+  // 1. Read what arrived since the last step (bounded); check every command frame.
+  bool fresh = false, bad = false;
+  std::uint16_t dropped = 0;
   for (std::size_t i = 0; i < kMaxDrain; ++i) {
     auto f = bus.receive(std::chrono::nanoseconds(0));
     if (!f) break;
-    if (!f->extended && f->id == layout_.command_id && f->len >= layout_.command_len) {
-      const CommandMsg c = layout_.unpack_command(*f);
-      if (cmd_.on_frame(c.counter)) {
-        current_mA_ = c.solenoid_a_mA;  // B current and restrictor command are not modelled
-        cmd_counter_ = c.counter;
-        fresh = true;
+    if (!f->extended && f->id == layout_.command_id) {
+      ++cmd_.received;
+      if (const auto why = layout_.check_command(*f)) {
+        cmd_.on_drop(*why);
+        bad = true;
+        ++dropped;
+        continue;
       }
+      const CommandMsg c = layout_.unpack_command(*f);
+      if (!cmd_.on_counter(c.counter)) {
+        bad = true;
+        ++dropped;
+        continue;
+      }
+      command_mA_ = c.solenoid_a_mA;  // B current and restrictor command are not modelled
+      fresh = true;
     } else if (layout_.is_connect(*f)) {
       reply_dto(bus);
     } else {
@@ -81,7 +137,58 @@ void SlaveNode::step(can::Bus& bus, double now_s) noexcept {
     }
   }
   cmd_.end_step();
-  plant_.apply(current_mA_);
+  watch_.end_step(fresh, bad);
+
+  // 2. Safe-state machine (nodes.hpp).
+  const auto ramp = [&]() noexcept { current_mA_ = std::max(cfg_.current_min_mA, current_mA_ - ramp_step_mA_); };
+  const bool recovered = watch_.good_run >= cfg_.e2e.recovery_frames;
+  switch (state_) {
+    case SlaveState::startup:  // stepped without a CONNECT (simulations): as connected
+    case SlaveState::connected:
+      if (fresh && !bad) {
+        go(SlaveState::running, NodeEventKind::input_valid, now_s);
+        current_mA_ = command_mA_;
+      }
+      break;
+    case SlaveState::running:
+      if (bad) {
+        go(SlaveState::degraded, NodeEventKind::input_implausible, now_s);
+        ramp();
+      } else if (fresh) {
+        current_mA_ = command_mA_;
+      } else if (watch_.misses >= cfg_.stale_periods) {
+        go(SlaveState::degraded, NodeEventKind::input_stale, now_s);
+        ramp();
+      }  // else: hold the last command (a late frame)
+      break;
+    case SlaveState::degraded:
+      if (recovered) {
+        go(SlaveState::running, NodeEventKind::input_recovered, now_s);
+        current_mA_ = command_mA_;
+      } else {
+        ramp();
+      }
+      break;
+    case SlaveState::safe:
+      current_mA_ = cfg_.current_min_mA;
+      if (recovered) {
+        go(SlaveState::running, NodeEventKind::input_resumed, now_s);
+        current_mA_ = command_mA_;
+      }
+      break;
+    default: break;
+  }
+  if (state_ == SlaveState::degraded && current_mA_ <= cfg_.current_min_mA)
+    go(SlaveState::safe, NodeEventKind::ramp_done, now_s);
+
+  // 3. The current driver: never outside its range, whatever was decided above.
+  double i = current_mA_;
+  if (!(i >= cfg_.current_min_mA)) i = cfg_.current_min_mA;  // also NaN
+  if (i > cfg_.current_max_mA) i = cfg_.current_max_mA;
+  current_mA_ = i;
+
+  // 4. Plant and sensor frame.
+  plant_.apply(i);
   const double y = plant_.measure();
   SensorMsg s;
   s.pilot_raw = plant_.last_raw();
@@ -92,32 +199,12 @@ void SlaveNode::step(can::Bus& bus, double now_s) noexcept {
   else
     ++send_fail_;
   if (n_log_ < log_.size())
-    log_[n_log_++] = SlaveStepLog{step_, cmd_counter_, fresh, current_mA_, plant_.true_pressure_kPa(), y, s.pilot_raw};
+    log_[n_log_++] =
+        SlaveStepLog{step_, state_, cmd_.extended, fresh, dropped, i, plant_.true_pressure_kPa(), y, s.pilot_raw};
   ++step_;
 }
 
 // ----------------------------------------------------------------------------- master
-
-const char* to_string(MasterState s) noexcept {
-  switch (s) {
-    case MasterState::connecting: return "connecting";
-    case MasterState::running: return "running";
-    case MasterState::fault: return "fault";
-    case MasterState::failed: return "failed";
-  }
-  return "?";
-}
-
-const char* to_string(MasterEventKind k) noexcept {
-  switch (k) {
-    case MasterEventKind::connect_sent: return "ccp_connect_sent";
-    case MasterEventKind::connected: return "ccp_connected";
-    case MasterEventKind::sensor_timeout: return "sensor_timeout_safe_state";
-    case MasterEventKind::sensor_resumed: return "sensor_resumed";
-    case MasterEventKind::dto_timeout: return "dto_timeout";
-  }
-  return "?";
-}
 
 MasterNode::MasterNode(const BenchLayout& layout, MasterConfig config)
     : layout_(layout),
@@ -127,13 +214,16 @@ MasterNode::MasterNode(const BenchLayout& layout, MasterConfig config)
   if (cfg_.fault_missed_periods == 0) throw std::invalid_argument("master: fault_missed_periods must be >= 1");
   if (cfg_.cro_retry_steps == 0) throw std::invalid_argument("master: cro_retry_steps must be >= 1");
   if (!(cfg_.dto_timeout_s > 0)) throw std::invalid_argument("master: dto_timeout_s must be > 0");
+  validate(cfg_.e2e, layout_.sensor_counter_bits(), "master");
+  sens_ = make_tracker(layout_.sensor_counter_bits(), cfg_.e2e);
+  ramp_step_mA_ = cfg_.e2e.ramp_mA_per_s * cfg_.controller.pid.dt_s;
   log_.resize(cfg_.log_capacity);
-  events_.resize(256);
   bus_log_.resize(cfg_.bus_log_capacity ? cfg_.bus_log_capacity : 4 * cfg_.log_capacity + 64);
 }
 
-void MasterNode::event(MasterEventKind kind, double now_s) noexcept {
-  if (n_events_ < events_.size()) events_[n_events_++] = MasterEvent{k_, now_s, kind};
+void MasterNode::go(MasterState to, NodeEventKind why, double now_s) noexcept {
+  events_.add(NodeEvent{k_, now_s, why, state_, to});
+  state_ = to;
 }
 
 void MasterNode::record(const can::Frame& f, bool sent) noexcept {
@@ -156,20 +246,31 @@ void MasterNode::send(can::Bus& bus, const can::Frame& f, double now_s) noexcept
 
 bool MasterNode::step(can::Bus& bus, double now_s) noexcept {
   if (state_ == MasterState::failed) return false;
-  // 1. Read what arrived since the last step (bounded).
-  bool dto = false, fresh = false;
+  // 1. Read what arrived since the last step (bounded); check every sensor frame.
+  bool dto = false;
+  fresh_ = bad_ = false;
+  std::uint16_t dropped = 0;
   for (std::size_t i = 0; i < kMaxDrain; ++i) {
     auto f = bus.receive(std::chrono::nanoseconds(0));
     if (!f) break;
-    if (!f->extended && f->id == layout_.sensors_id && f->len >= layout_.sensors_len) {
+    if (!f->extended && f->id == layout_.sensors_id) {
       record(*f, false);
-      const SensorMsg s = layout_.unpack_sensors(*f);
-      if (sens_.on_frame(s.counter)) {
-        measured_kPa_ = decode_pressure_raw(s.pilot_raw);
-        sensor_counter_ = s.counter;
-        have_measurement_ = true;
-        fresh = true;
+      ++sens_.received;
+      if (const auto why = layout_.check_sensors(*f)) {
+        sens_.on_drop(*why);
+        bad_ = true;
+        ++dropped;
+        continue;
       }
+      const SensorMsg s = layout_.unpack_sensors(*f);
+      if (!sens_.on_counter(s.counter)) {
+        bad_ = true;
+        ++dropped;
+        continue;
+      }
+      measured_kPa_ = decode_pressure_raw(s.pilot_raw);
+      sensor_counter_ = s.counter;
+      fresh_ = true;
     } else if (layout_.is_connect_ack(*f)) {
       record(*f, false);
       dto = true;
@@ -178,62 +279,34 @@ bool MasterNode::step(can::Bus& bus, double now_s) noexcept {
     }
   }
   sens_.end_step();
+  watch_.end_step(fresh_, bad_);
 
-  // 2. State machine.
-  bool send_cmd = false;
-  if (state_ == MasterState::connecting) {
+  // 2. CCP handshake.
+  if (state_ == MasterState::startup) {
     if (dto && cro_sent_) {
-      state_ = MasterState::running;
       handshake_s_ = now_s - first_cro_s_;
       controller_.reset();
-      misses_ = 0;
-      event(MasterEventKind::connected, now_s);
-    } else {
-      if (cro_sent_ && now_s - first_cro_s_ >= cfg_.dto_timeout_s) {
-        state_ = MasterState::failed;
-        event(MasterEventKind::dto_timeout, now_s);
-      } else if (!cro_sent_ || k_ - last_cro_k_ >= cfg_.cro_retry_steps) {
-        send(bus, layout_.pack_connect(cro_ctr_), now_s);
-        if (!cro_sent_) {
-          first_cro_s_ = now_s;
-          event(MasterEventKind::connect_sent, now_s);
-        }
-        cro_sent_ = true;
-        last_cro_k_ = k_;
+      go(MasterState::connected, NodeEventKind::connected, now_s);
+    } else if (cro_sent_ && now_s - first_cro_s_ >= cfg_.dto_timeout_s) {
+      go(MasterState::failed, NodeEventKind::dto_timeout, now_s);
+    } else if (!cro_sent_ || k_ - last_cro_k_ >= cfg_.cro_retry_steps) {
+      send(bus, layout_.pack_connect(cro_ctr_), now_s);
+      if (!cro_sent_) {
+        first_cro_s_ = now_s;
+        events_.add(NodeEvent{k_, now_s, NodeEventKind::connect_sent, state_, state_});
       }
+      cro_sent_ = true;
+      last_cro_k_ = k_;
     }
   }
+
+  // 3. Safe-state machine (nodes.hpp) and the control law.
+  const bool send_cmd = state_ != MasterState::startup && state_ != MasterState::failed;
   double r = 0.0;
-  if (state_ == MasterState::running || state_ == MasterState::fault) {
+  if (send_cmd) {
     ++m_;
     r = reference_.next();
-    send_cmd = true;
-    if (state_ == MasterState::fault && fresh) {
-      state_ = MasterState::running;
-      controller_.reset();
-      event(MasterEventKind::sensor_resumed, now_s);
-    }
-    if (state_ == MasterState::running) {
-      if (fresh) {
-        misses_ = 0;
-        current_mA_ = controller_.step(r, measured_kPa_);
-      } else if (++misses_ >= cfg_.fault_missed_periods) {
-        state_ = MasterState::fault;
-        current_mA_ = 0.0;  // safe state
-        // No forget(): frames missed now are counted lost when the counter resumes; a restarted
-        // slave (counter back at 0) shows up as a resync.
-        last_cro_k_ = k_;
-        event(MasterEventKind::sensor_timeout, now_s);
-      } else if (!have_measurement_) {
-        current_mA_ = 0.0;
-      }  // else: hold the last command for up to N − 1 missed periods
-    } else {
-      current_mA_ = 0.0;
-      if (k_ - last_cro_k_ >= cfg_.cro_retry_steps) {  // reconnect a restarted slave
-        send(bus, layout_.pack_connect(cro_ctr_), now_s);
-        last_cro_k_ = k_;
-      }
-    }
+    control(bus, r, now_s);
   }
   if (send_cmd) {
     CommandMsg c;
@@ -250,13 +323,74 @@ bool MasterNode::step(can::Bus& bus, double now_s) noexcept {
     l.reference_kPa = r;
     l.measured_kPa = measured_kPa_;
     l.sensor_counter = sensor_counter_;
-    l.sensor_fresh = fresh;
+    l.sensor_fresh = fresh_;
+    l.dropped = dropped;
     l.current_mA = send_cmd ? current_mA_ : 0.0;
+    l.integrator_mA = controller_.pid().integrator();
     l.command_counter = static_cast<std::uint16_t>(cmd_counter_ - (send_cmd ? 1 : 0));
     l.command_sent = send_cmd;
   }
   ++k_;
   return state_ != MasterState::failed;
+}
+
+// One control step in states connected..safe: sets current_mA_.
+void MasterNode::control(can::Bus& bus, double r, double now_s) noexcept {
+  const double safe_mA = cfg_.controller.current_min_mA;
+  const bool stale = watch_.misses >= cfg_.fault_missed_periods;
+  const bool recovered = watch_.good_run >= cfg_.e2e.recovery_frames;
+  auto to_safe = [&](NodeEventKind why) noexcept {
+    go(MasterState::safe, why, now_s);
+    current_mA_ = safe_mA;
+    last_cro_k_ = k_;
+  };
+  switch (state_) {
+    case MasterState::connected:
+      if (fresh_ && !bad_) {
+        go(MasterState::running, NodeEventKind::input_valid, now_s);
+        current_mA_ = controller_.step(r, measured_kPa_);
+      } else if (stale) {
+        to_safe(NodeEventKind::sensor_timeout);
+      } else {
+        current_mA_ = safe_mA;
+      }
+      break;
+    case MasterState::running:
+      if (bad_) {
+        go(MasterState::degraded, NodeEventKind::input_implausible, now_s);
+      } else if (fresh_) {
+        current_mA_ = controller_.step(r, measured_kPa_);
+      } else if (stale) {
+        // No forget(): frames missed now are counted lost when the counter resumes; a restarted
+        // slave (counter back at 0) re-synchronises after sync_frames frames.
+        to_safe(NodeEventKind::sensor_timeout);
+      }  // else: hold the last command for up to N − 1 missed periods (a late frame)
+      break;
+    case MasterState::degraded:
+      if (stale) {
+        to_safe(NodeEventKind::sensor_timeout);
+      } else if (recovered) {  // the PID resumes where it was frozen
+        go(MasterState::running, NodeEventKind::input_recovered, now_s);
+        current_mA_ = controller_.step(r, measured_kPa_);
+      }
+      break;
+    case MasterState::safe:
+      current_mA_ = safe_mA;
+      if (recovered) {
+        go(MasterState::running, NodeEventKind::input_resumed, now_s);
+        controller_.reset();
+        current_mA_ = controller_.step(r, measured_kPa_);
+      } else if (stale && k_ - last_cro_k_ >= cfg_.cro_retry_steps) {  // reconnect a restarted slave
+        send(bus, layout_.pack_connect(cro_ctr_), now_s);
+        last_cro_k_ = k_;
+      }
+      break;
+    default: break;
+  }
+  if (state_ == MasterState::degraded) {  // PID frozen (not stepped): ramp the held command to the safe one
+    current_mA_ = std::max(safe_mA, current_mA_ - ramp_step_mA_);
+    if (current_mA_ <= safe_mA) go(MasterState::safe, NodeEventKind::ramp_done, now_s);
+  }
 }
 
 }  // namespace lash::hil

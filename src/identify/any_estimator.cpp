@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "lash/metrics/first_order.hpp"
+
 namespace lash {
 
 namespace {
@@ -21,16 +23,6 @@ Var make(const EstimatorConfig& c) {
 }  // namespace
 
 AnyEstimator::AnyEstimator(const EstimatorConfig& cfg) : cfg_(cfg), e_(make(cfg)) {}
-
-SideParams AnyEstimator::params(Side s) const noexcept {
-  if (const auto* e = std::get_if<LinearEstimator>(&e_)) return e->params();
-  return std::visit(
-      [&](const auto& e) noexcept -> SideParams {
-        if constexpr (std::is_same_v<std::decay_t<decltype(e)>, LinearEstimator>) return e.params();
-        else return e.params(s);
-      },
-      e_);
-}
 
 std::vector<std::string> AnyEstimator::param_names() const {
   switch (cfg_.model) {
@@ -69,12 +61,21 @@ EstimateReport AnyEstimator::report() const {
   rep.model = cfg_.model;
   rep.samples = samples_;
   rep.identified = identified();
-  rep.right.params = params(Side::right);
-  rep.left.params = params(Side::left);
+  auto fill = [this](SideReport& r, Side s) {
+    SideParams p = params(s);
+    p.reason = verdict(s);
+    p.identified = p.reason == Reason::none;
+    r.K = static_gain(p.a1, p.b1);
+    r.tau_s = time_constant_s(p.a1, cfg_.dt_s);
+    r.params = p;
+  };
+  fill(rep.right, Side::right);
+  fill(rep.left, Side::left);
   std::visit(
       [&](const auto& e) {
         using E = std::decay_t<decltype(e)>;
         rep.skipped = e.skipped();
+        rep.fit_nrmse = e.fit_nrmse();
         if constexpr (std::is_same_v<E, LinearEstimator>) {
           rep.right.updates = {{"all", e.updates()}};
         } else if constexpr (std::is_same_v<E, DeadzoneDeadbandEstimator>) {
@@ -88,6 +89,7 @@ EstimateReport AnyEstimator::report() const {
           if constexpr (std::is_same_v<E, CoupledCartsEstimator>) {
             rep.has_shared_d = true;
             rep.d = e.deadband();
+            rep.d_reason = e.deadband_reason();
             rep.d_updates = {{"+", e.deadband_updates(true)}, {"-", e.deadband_updates(false)}};
           }
         }
@@ -119,30 +121,11 @@ EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> 
   return run;
 }
 
-double nrmse(std::span<const double> t, std::span<const double> y, std::span<const double> ysim, double t0_s,
-             double t1_s) {
-  double se = 0.0, ymax = 0.0;
-  std::size_t n = 0;
-  for (std::size_t k = 0; k < t.size(); ++k) {
-    if (t[k] < t0_s || t[k] > t1_s) continue;
-    const double e = y[k] - ysim[k];
-    se += e * e;
-    ymax = std::max(ymax, std::fabs(y[k]));
-    ++n;
-  }
-  if (n == 0 || ymax == 0.0) return std::numeric_limits<double>::quiet_NaN();
-  return std::sqrt(se / static_cast<double>(n)) / ymax;
-}
-
-double outside_3sigma_per_1000(std::span<const double> t, std::span<const double> y, std::span<const double> yhat,
-                               double sigma, double t0_s, double t1_s) {
-  std::size_t n = 0, out = 0;
-  for (std::size_t k = 0; k < t.size(); ++k) {
-    if (t[k] < t0_s || t[k] > t1_s) continue;
-    ++n;
-    if (!(std::fabs(y[k] - yhat[k]) <= 3.0 * sigma)) ++out;
-  }
-  return n == 0 ? std::numeric_limits<double>::quiet_NaN() : 1000.0 * static_cast<double>(out) / static_cast<double>(n);
+void add_intervals(EstimationRun& run, const EstimatorConfig& cfg, std::span<const double> v,
+                   std::span<const double> y) {
+  const auto ci = batch_means_intervals(cfg, v, y, {run.report.right.params, run.report.left.params});
+  if (run.report.right.params.identified) run.report.right.ci95 = ci.right;
+  if (run.report.left.params.identified) run.report.left.ci95 = ci.left;
 }
 
 }  // namespace lash

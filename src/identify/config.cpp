@@ -75,6 +75,8 @@ void EstimatorConfig::validate() const {
   require(std::isfinite(singular_tol) && singular_tol > 0, "singular-tol", "must be > 0");
   require(std::isfinite(zero_threshold) && zero_threshold >= 0, "zero-threshold", "must be >= 0");
   require(accel_limit > 0, "accel-limit", "must be > 0");
+  require(std::isfinite(fit_threshold) && fit_threshold > 0, "fit-threshold", "must be > 0 (a fraction: 0.2 = 20 %)");
+  require(std::isfinite(fit_start_s) && fit_start_s >= 0, "fit-start", "must be >= 0 [s]");
   require(std::isfinite(stage2_start_s) && stage2_start_s >= 0, "stage2-start", "must be >= 0 [s]");
   if (method == EstimationMethod::iv)
     require(rls.forgetting == Forgetting::exponential, "forgetting", "iv supports exponential forgetting only");

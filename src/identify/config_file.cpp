@@ -50,6 +50,8 @@ void read_estimator_config(TomlTable& t, EstimatorConfig& c, EstimationJob* job)
   c.zero_threshold = t.number_or("zero_threshold", c.zero_threshold);
   c.accel_limit = t.number_or("accel_limit", c.accel_limit);
   c.stage2_start_s = t.number_or("stage2_start", c.stage2_start_s);
+  c.fit_threshold = t.number_or("fit_threshold", c.fit_threshold);
+  c.fit_start_s = t.number_or("fit_start", c.fit_start_s);
   if (job) {
     if (auto cols = t.strings_opt("columns")) {
       if (cols->size() != 3) t.fail("columns", "expected three names [t, v, y]");

@@ -29,6 +29,16 @@ void sleep_until_ns(std::int64_t t_ns, const std::atomic<bool>* stop) noexcept {
   }
 }
 
+std::string use_fifo(int priority) {
+  if (priority < 1 || priority > 99) return "SCHED_FIFO priority must be 1..99";
+  sched_param sp{};
+  sp.sched_priority = priority;
+  if (sched_setscheduler(0, SCHED_FIFO, &sp) != 0)
+    return std::string("SCHED_FIFO priority ") + std::to_string(priority) + " refused (" + std::strerror(errno) +
+           "; needs CAP_SYS_NICE or RLIMIT_RTPRIO)";
+  return "";
+}
+
 Summary summarize(std::span<const double> values) {
   Summary s;
   s.n = values.size();

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs one libFuzzer target (built in the clang tree with LASH_BUILD_FUZZ=ON, as `make test`
 # does) for a bounded time, starting from the seed corpus in fuzz/corpus/<name>.
-# Usage: can_fuzz.sh <dbc|log|datagram> <seconds>
+# Usage: can_fuzz.sh <dbc|log|datagram|asc|blf|trc> <seconds>
 set -euo pipefail
 name=$1
 secs=$2

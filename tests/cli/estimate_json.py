@@ -27,14 +27,25 @@ with tempfile.TemporaryDirectory() as d:
     lines = [l for l in out.splitlines() if l.strip()]
     check(len(lines) == 1, "stdout is one line")
     j = json.loads(out)
-    old = ["model", "samples", "right", "left", "nrmse", "nrmse_window_s"]
-    check([k for k in j if k in old] == old and j.get("rows_skipped") == 0 and j.get("gaps") == 0, f"keys {list(j)}")
+    # every key of before keeps its name and order; the verdict, units and percentage are added
+    check([k for k in j if k not in ("nrmse_pct", "rows_skipped", "gaps")] == ["model", "samples", "right", "left", "nrmse", "nrmse_window_s"],
+          f"keys {list(j)}")
+    check(abs(j["nrmse_pct"] - 100 * j["nrmse"]) <= 1e-12 * max(1.0, j["nrmse_pct"]), "nrmse_pct = 100 nrmse")
+    check(j.get("rows_skipped") == 0 and j.get("gaps") == 0, "no rows skipped, no gaps")
     check(j["model"] == "deadzone-deadband" and j["samples"] == 40000, "model and samples")
     truth = {"right": dict(a1=-0.96, b1=0.1, c=200.0, d=30.0), "left": dict(a1=-0.94, b1=0.15, c=-300.0, d=50.0)}
     for side in ("right", "left"):
         s = j[side]
-        check(list(s.keys()) == ["a1", "b1", "c", "d", "identified", "updates"], f"{side} keys {list(s)}")
-        check(s["identified"] is True, f"{side} identified")
+        check(list(s.keys()) == ["a1", "b1", "c", "d", "identified", "updates", "reason", "K", "tau_s", "ci95"],
+              f"{side} keys {list(s)}")
+        ci = s["ci95"]
+        check(list(ci) == ["a1", "b1", "c", "d", "K", "tau_s"] and all(
+            ci[k][0] <= s[k] <= ci[k][1] for k in ("a1", "b1", "c", "d", "K", "tau_s")), f"{side} ci95 {ci}")
+        check(s["identified"] is True and s["reason"] is None, f"{side} identified")
+        # K = b1/(1 + a1), tau = -T/ln(-a1) with T = 5 ms, from the truth by hand
+        K, tau = truth[side]["b1"] / (1 + truth[side]["a1"]), -0.005 / math.log(-truth[side]["a1"])
+        check(abs(s["K"] - K) <= 1e-4 * K and abs(s["tau_s"] - tau) <= 1e-4 * tau,
+              f"{side} K = {s['K']} vs {K}, tau = {s['tau_s']} vs {tau}")
         check(set(s["updates"]) == {"+", "-"} and min(s["updates"].values()) > 1000, f"{side} updates {s['updates']}")
         for k, v in truth[side].items():
             check(abs(s[k] - v) <= 1e-4 * abs(v), f"{side} {k} = {s[k]} vs {v}")
@@ -53,9 +64,8 @@ with tempfile.TemporaryDirectory() as d:
     out = subprocess.run([LASH, "estimate", "--model", "linear", data, "--json"], check=True, capture_output=True,
                          text=True).stdout
     j = json.loads(out)
-    old = ["model", "samples", "a1", "b1", "identified", "updates", "nrmse", "nrmse_window_s"]
-    check([k for k in j if k in old] == old and j.get("rows_skipped") == 0 and j.get("gaps") == 0,
-          f"linear keys {list(j)}")
+    check(list(j.keys()) == ["model", "samples", "a1", "b1", "identified", "updates", "reason", "K", "tau_s", "ci95",
+                             "nrmse", "nrmse_pct", "nrmse_window_s", "rows_skipped", "gaps"], f"linear keys {list(j)}")
     # input-deadzone: no d; a side never excited is null + identified false
     out = subprocess.run([LASH, "estimate", "--model", "input-deadzone", "--guess-left", "-700",
                           "--guess-right", "350", data, "--json"], check=True, capture_output=True, text=True).stdout
@@ -63,6 +73,7 @@ with tempfile.TemporaryDirectory() as d:
     check("d" not in j["right"] and "c" in j["right"], "input-deadzone has c, no d")
     check(j["left"]["identified"] is False and j["left"]["c"] is None and j["left"]["a1"] is None,
           f"left never updated -> null: {j['left']}")
+    check(j["left"]["reason"] == "not_updated", f"left reason {j['left']['reason']}")
     # renamed columns + config file
     cfg = os.path.join(d, "est.toml")
     with open(cfg, "w") as f:

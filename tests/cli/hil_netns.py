@@ -35,6 +35,33 @@ def enter_private_netns():
     sys.exit(subprocess.run([unshare, *flags, sys.executable, *sys.argv], env=env).returncode)
 
 
+def crc8_j1850(data):
+    """CRC-8 SAE J1850, bit by bit: poly 0x1D, init 0xFF, xorout 0xFF, MSB first (independent of
+    lash's table-driven code; the tests check it against python3-crcmod and the check value)."""
+    reg = 0xFF
+    for b in data:
+        reg ^= b
+        for _ in range(8):
+            reg = ((reg << 1) ^ 0x1D) & 0xFF if reg & 0x80 else (reg << 1) & 0xFF
+    return reg ^ 0xFF
+
+
+def check_crc8_j1850():
+    """The catalogue check value, and python3-crcmod (whose initCrc is init XOR xorout) agreeing."""
+    import crcmod
+    assert crc8_j1850(b"123456789") == 0x4B
+    ref = crcmod.mkCrcFun(0x11D, initCrc=0x00, rev=False, xorOut=0xFF)
+    for probe in (b"123456789", bytes(range(9)), bytes([0xFF] * 8), b"\x00\x01\x02"):
+        assert ref(probe) == crc8_j1850(probe), probe
+
+
+def e2e_crc(arbitration_id, data, crc_byte):
+    """The bench DBC's E2E CRC: data ID (identifier low byte, high byte) + payload without the CRC byte."""
+    body = bytes([arbitration_id & 0xFF, (arbitration_id >> 8) & 0xFF]) + bytes(
+        b for i, b in enumerate(data) if i != crc_byte)
+    return crc8_j1850(body)
+
+
 def lash():
     return os.environ["LASH"]
 

@@ -35,8 +35,62 @@ TEST(CanLog, FrameText) {
   f = parse_frame_text("001#11.22.33", err);
   ASSERT_TRUE(f);
   EXPECT_EQ(f->len, 3);
-  for (const char* bad : {"800#00", "12#00", "123#0", "123#GG", "123#001122334455667788", "3FFFFFFF#00", "123", "123#R9"})
+  for (const char* bad : {"800#00", "12#00", "123#0", "123#GG", "123#001122334455667788", "5FFFFFFF#00", "123", "123#R9",
+                          "123##4AA", "123##1001122334455667788", "123##R"})
     EXPECT_FALSE(parse_frame_text(bad, err)) << bad;
+}
+
+TEST(CanLog, ErrorAndFdFlags) {
+  std::string err;
+  // candump -e: CAN_ERR_FLAG (0x20000000) | error class, 8 data bytes
+  auto f = parse_frame_text("20000080#0000000000000000", err);
+  ASSERT_TRUE(f) << err;
+  EXPECT_TRUE(f->error);
+  EXPECT_FALSE(f->extended);
+  EXPECT_EQ(f->id, 0x80u);
+  EXPECT_TRUE(f->valid());
+  EXPECT_EQ(format_frame_text(*f), "20000080#0000000000000000");
+  // CAN FD flags digit: 1 = BRS, 2 = ESI
+  f = parse_frame_text("123##3AABB", err);
+  ASSERT_TRUE(f) << err;
+  EXPECT_TRUE(f->fd && f->brs && f->esi);
+  EXPECT_EQ(format_frame_text(*f), "123##3AABB");
+  f = parse_frame_text("12345678##1" + std::string(24, '0'), err);
+  ASSERT_TRUE(f) << err;
+  EXPECT_TRUE(f->fd && f->brs && !f->esi && f->extended);
+  EXPECT_EQ(f->len, 12);
+  Frame g = *f;
+  g.brs = false;
+  EXPECT_FALSE(same_content(g, *f));  // the flags are part of the content
+}
+
+TEST(CanLog, CandumpDefaultOutput) {
+  std::string err;
+  auto e = parse_log_line("  vcan0  0C8   [8]  F0 00 00 00 00 00 00 01", err);
+  ASSERT_TRUE(e) << err;
+  EXPECT_EQ(e->frame.id, 0xC8u);
+  EXPECT_EQ(e->frame.len, 8);
+  EXPECT_EQ(e->frame.data[7], 1);
+  e = parse_log_line(" (2020-12-19 12:04:45.485261)  vcan0  1F4   [4]  01 02 03 04", err);
+  ASSERT_TRUE(e) << err;
+  EXPECT_NEAR(e->frame.timestamp_s, 1608379485.485261, 1e-6);  // calendar.timegm((2020,12,19,12,4,45))
+  e = parse_log_line(" (012.831664)  vcan0  1F4   [4]  01 02 03 04", err);
+  ASSERT_TRUE(e) << err;
+  EXPECT_NEAR(e->frame.timestamp_s, 12.831664, 1e-9);
+  e = parse_log_line("  vcan0  20000004   [8]  00 00 00 00 00 00 00 00   ERRORFRAME", err);
+  ASSERT_TRUE(e) << err;
+  EXPECT_TRUE(e->frame.error);
+  EXPECT_EQ(e->frame.id, 4u);
+  for (const char* bad : {"  vcan0  064   [10]  F0 01 FF FF FF FF FF FF FF FF", "  vcan0  ERROR", "  vcan0  0C8   [3]  F0 00"})
+    EXPECT_FALSE(parse_log_line(bad, err)) << bad;
+  // a tolerant read counts and locates the bad lines
+  LogReadReport report;
+  const auto v = parse_log("  vcan0  0C8   [1]  F0\n  vcan0  ERROR\n\n(1.000000) can0 123#00\n", "x.log", &report);
+  EXPECT_EQ(v.size(), 2u);
+  EXPECT_EQ(report.dropped, 1u);
+  ASSERT_EQ(report.problems.size(), 1u);
+  EXPECT_NE(report.problems[0].find("x.log:2"), std::string::npos) << report.problems[0];
+  EXPECT_THROW(parse_log("  vcan0  ERROR\n", "x.log"), lash::InputError);
 }
 
 TEST(CanLog, Lines) {

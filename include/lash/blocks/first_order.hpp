@@ -3,6 +3,7 @@
 /// First-order discrete linear part (thesis eq. 8–10), piecewise per side:
 /// w(k) = −a1·w(k−1) + b1·u(k−1), i.e. G(z) = b1 / (z + a1).
 #include "lash/blocks/side.hpp"
+#include "lash/metrics/first_order.hpp"
 
 namespace lash {
 
@@ -13,10 +14,10 @@ struct FirstOrderParams {
   /// Zero-order-hold discretisation of K/(τs + 1) (eq. 9–10):
   /// a1 = −exp(−T/τ), b1 = K(1 − exp(−T/τ)). Throws unless τ > 0, T > 0.
   static FirstOrderParams from_continuous(double gain, double tau_s, double dt_s);
-  /// Steady-state gain K = b1 / (1 + a1).
-  double gain() const noexcept { return b1 / (1.0 + a1); }
-  /// Time constant τ = −T / ln(−a1) [s]; only meaningful for −1 < a1 < 0.
-  double tau_s(double dt_s) const noexcept;
+  /// Steady-state gain K = b1 / (1 + a1) (lash::static_gain).
+  double gain() const noexcept { return static_gain(a1, b1); }
+  /// Time constant τ = −T / ln(−a1) [s] (lash::time_constant_s); NaN unless −1 < a1 < 0.
+  double tau_s(double dt_s) const noexcept { return time_constant_s(a1, dt_s); }
 };
 
 class FirstOrder {

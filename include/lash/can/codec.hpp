@@ -118,8 +118,9 @@ class SignalCodec {
 /// All signals of one DBC message, with multiplexing.
 class MessageCodec {
  public:
-  /// Throws std::invalid_argument (naming the signal) when a signal cannot be
-  /// coded or does not fit the message's size. Not real-time safe.
+  /// Throws std::invalid_argument (naming the signal) when dbc::check_layout()
+  /// finds an error (a signal that cannot be coded or does not fit the message's
+  /// size, a multiplexed signal without multiplexor). Not real-time safe.
   explicit MessageCodec(const dbc::Message& message);
 
   const dbc::Message& message() const noexcept { return message_; }
@@ -129,7 +130,8 @@ class MessageCodec {
   const SignalCodec& codec(std::size_t i) const noexcept { return codecs_[i]; }
 
   /// Decodes all signals into `values` (size == signal_count()). Multiplexed
-  /// signals not selected by the multiplexor's value come out as NaN.
+  /// signals not selected (by their multiplexor's raw value, through every level of
+  /// extended multiplexing) come out as NaN.
   /// False (values untouched) when a span is too short.
   bool decode(std::span<const std::uint8_t> data, std::span<double> values) const noexcept;
 
@@ -154,14 +156,22 @@ class MessageCodec {
     std::uint64_t mask;
     double factor, inv_factor, offset, min_phys, max_phys, raw_lo, raw_hi_excl;
     std::uint8_t lo;       ///< LSB position in the word
-    std::uint8_t sext;     ///< 64 - length (sign extension shift)
+    std::uint8_t sext;     ///< 64 - length for signed integers, else 0 (sign extension shift)
     bool motorola, is_signed, has_range, multiplexed, integer, full64;
     std::uint64_t mux_value;
   };
+  /// Multiplexing: signal i is present when its multiplexor parent_[i] is present and
+  /// holds a raw value in ranges_[range_begin_[i] .. range_begin_[i + 1]).
+  bool selected(std::size_t i, std::span<const std::uint8_t> data, std::span<const double> values) const noexcept;
   std::vector<Lane> lanes_;
   bool packed_ = false;
   dbc::Message message_;
   std::vector<SignalCodec> codecs_;
+  std::vector<std::int32_t> parent_;       ///< multiplexor index per signal, -1 = always present
+  std::vector<std::uint32_t> order_;       ///< signal indices, multiplexors before what they select
+  std::vector<std::uint32_t> range_begin_;
+  std::vector<dbc::MuxRange> ranges_;
+  std::vector<std::uint8_t> present_;      ///< encode's scratch: signal selected by its multiplexors
   std::vector<std::uint64_t> mux_values_;  ///< per signal; meaningful when multiplexed
   std::vector<std::uint8_t> multiplexed_;
   std::size_t mux_index_ = 0;

@@ -11,7 +11,16 @@
 /// `M` / `m<n>`), CM_, BA_DEF_, BA_DEF_DEF_, BA_, VAL_, VAL_TABLE_,
 /// SIG_VALTYPE_. Other known DBC statements (EV_, BO_TX_BU_, SIG_GROUP_,
 /// BA_DEF_REL_, …) are kept verbatim and written back unchanged.
-/// Errors are lash::InputError naming file, line and column. Not real-time safe.
+/// Extended multiplexing (`m<n>M` switches and `SG_MUL_VAL_` ranges) is parsed into
+/// Signal::mux_switch / multiplexor / mux_ranges and written back.
+///
+/// Tolerant by default, like the tools engineers use: what is dubious becomes a
+/// Diagnostic (file:line, kind, what was done) and the rest of the file loads —
+/// ids above 0x7FF without bit 31 are extended, comments/value tables naming
+/// unknown objects are kept verbatim in other_statements, a statement without `;`
+/// ends at the next keyword, names may start with a digit, a statement that cannot
+/// be parsed is skipped. ParseOptions::strict turns every such warning into an
+/// InputError naming file, line and column. Not real-time safe.
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -24,6 +33,13 @@ namespace lash::can::dbc {
 enum class ByteOrder : std::uint8_t { motorola = 0, intel = 1 };  ///< the digit after '@'
 enum class ValueType : std::uint8_t { integer = 0, float32 = 1, float64 = 2 };  ///< SIG_VALTYPE_
 enum class MuxRole : std::uint8_t { none, multiplexor, multiplexed };
+
+/// A closed range of multiplexor raw values (SG_MUL_VAL_ `lo-hi`).
+struct MuxRange {
+  std::uint64_t lo = 0;
+  std::uint64_t hi = 0;
+  bool operator==(const MuxRange&) const = default;
+};
 
 struct ValueDescription {
   std::int64_t value = 0;
@@ -46,8 +62,17 @@ struct Signal {
   std::vector<std::string> receivers;
   MuxRole mux = MuxRole::none;
   std::uint64_t mux_value = 0;  ///< for MuxRole::multiplexed: the multiplexor value selecting it
+  bool mux_switch = false;      ///< multiplexed and a multiplexor itself (`m<n>M`, extended multiplexing)
+  std::string multiplexor;      ///< SG_MUL_VAL_: name of the multiplexor selecting it ("" = the message's `M`)
+  std::vector<MuxRange> mux_ranges;  ///< SG_MUL_VAL_: selecting raw values (empty = {mux_value})
   std::string comment;
   std::vector<ValueDescription> values;  ///< VAL_
+  /// Raw bits as the integer VAL_ keys use: sign-extended for signed signals.
+  std::int64_t value_key(std::uint64_t raw) const noexcept;
+  /// The VAL_ text of a raw value, or nullptr.
+  const std::string* value_text(std::uint64_t raw) const noexcept;
+  /// The raw bits a VAL_ text names (masked to the signal's length), or nullopt.
+  std::optional<std::uint64_t> value_raw(std::string_view text) const noexcept;
   bool operator==(const Signal&) const = default;
 };
 
@@ -59,9 +84,15 @@ struct Message {
   std::string transmitter;
   std::vector<Signal> signals;
   std::string comment;
+  /// True for a classic frame length 0–8 or a CAN FD length (12, 16, 20, 24, 32, 48, 64).
+  bool size_is_dlc() const noexcept {
+    return size <= 8 || size == 12 || size == 16 || size == 20 || size == 24 || size == 32 || size == 48 || size == 64;
+  }
   /// DBC id as written in the file (bit 31 set for extended ids).
   std::uint32_t dbc_id() const noexcept { return extended ? (id | 0x80000000u) : id; }
   const Signal* signal(std::string_view signal_name) const noexcept;
+  /// The multiplexor selecting `s` (SG_MUL_VAL_ name, else the message's `M`); nullptr if none.
+  const Signal* multiplexor_of(const Signal& s) const noexcept;
   bool operator==(const Message&) const = default;
 };
 
@@ -128,11 +159,38 @@ struct Database {
   bool operator==(const Database&) const = default;
 };
 
-/// Parses DBC text; `file` names the source in errors. Throws lash::InputError
-/// ("file:line: 'column N': message") on the first problem.
-Database parse_dbc(std::string_view text, const std::string& file = "<dbc>");
+/// A finding of the reader or of check_layout().
+struct Diagnostic {
+  enum class Severity : std::uint8_t { warning, error };
+  Severity severity = Severity::warning;
+  std::string file;
+  int line = 0;          ///< 1-based; 0 = not tied to one line
+  std::string kind;      ///< short tag, e.g. "implicit-extended-id", "missing-semicolon", "signal-out-of-frame"
+  std::string message;   ///< what was found and what was done
+  /// "file:line: warning: message [kind]"
+  std::string format() const;
+};
+
+struct ParseOptions {
+  bool strict = false;  ///< every warning is an InputError (the reader's behaviour before tolerance)
+};
+
+/// Parses DBC text; `file` names the source in errors and diagnostics. Warnings (and
+/// the layout errors of check_layout(), which leave the rest of the file usable) are
+/// appended to `diagnostics` when given. Throws lash::InputError only for what cannot
+/// be read at all (strict mode: on the first warning).
+Database parse_dbc(std::string_view text, const std::string& file = "<dbc>", const ParseOptions& options = {},
+                   std::vector<Diagnostic>* diagnostics = nullptr);
 /// Reads and parses a DBC file (InputError when it cannot be read).
-Database load_dbc(const std::filesystem::path& path);
+Database load_dbc(const std::filesystem::path& path, const ParseOptions& options = {},
+                  std::vector<Diagnostic>* diagnostics = nullptr);
+
+/// Layout problems of one message. Errors: a signal outside the frame or beyond 64
+/// bytes, a factor of 0, a float type with the wrong length, a multiplexed signal
+/// with no multiplexor, two signals that can be active together sharing a bit
+/// (only when `overlaps`). Warnings: a size that is no CAN (FD) length. A message
+/// with errors cannot be coded (MessageCodec throws); the others are unaffected.
+std::vector<Diagnostic> check_layout(const Message& message, const std::string& file = "", bool overlaps = true);
 /// Writes a Database as DBC text; parse_dbc(write_dbc(db)) == db.
 std::string write_dbc(const Database& db);
 

@@ -1,12 +1,13 @@
 #pragma once
 /// @file log.hpp
-/// can-utils text forms of frames:
+/// Bus logs. can-utils text forms of frames:
 ///  - `ID#HEXDATA` (cansend): 3 hex digits = 11-bit id, 8 hex digits = 29-bit id;
 ///    `ID#R` / `ID#R<dlc>` remote frames; `ID##<flags>HEXDATA` CAN FD;
 ///  - `candump -L` log lines: `(seconds.microseconds) iface ID#HEXDATA` with six
 ///    microsecond digits (an optional trailing ` R`/` T` direction, as python-can
 ///    writes, is accepted). canplayer and python-can's CanutilsLogReader read them.
 /// Not real-time safe (strings).
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -32,12 +33,26 @@ std::optional<LogEntry> parse_log_line(std::string_view line, std::string& error
 /// `(1600000000.123456) vcan0 123#DEADBEEF` (no newline); time rounded to 1 µs.
 std::string format_log_line(const Frame& frame, std::string_view interface);
 
-/// Reads a candump -L log. Blank lines are skipped. Throws lash::InputError
-/// naming file, line and field on the first bad line.
-std::vector<LogEntry> read_log(const std::filesystem::path& path);
-/// Parses log text (same rules as read_log; `file` names the source in errors).
-std::vector<LogEntry> parse_log(std::string_view text, const std::string& file = "<log>");
-/// Writes entries atomically (lash::AtomicFile).
+/// Log file formats, chosen by extension: .asc (Vector ASCII), .blf (Vector binary
+/// logging format), .trc (PEAK trace), anything else candump (-L or default output).
+enum class LogFormat : std::uint8_t { candump, asc, blf, trc };
+LogFormat log_format_of(const std::filesystem::path& path) noexcept;
+const char* to_string(LogFormat f) noexcept;
+
+/// What a tolerant read left out: every dropped line/object, counted and located.
+struct LogReadReport {
+  std::size_t dropped = 0;
+  std::vector<std::string> problems;  ///< "file:line: why" (BLF: "file@offset: why")
+};
+
+/// Reads a log of any LogFormat (by extension). Blank lines and comments are skipped.
+/// Without `report`: throws lash::InputError naming file, line (offset) and field on
+/// the first bad line or object. With `report`: bad lines are dropped, counted and
+/// listed there; a file that cannot be read at all (missing, not a BLF, …) still throws.
+std::vector<LogEntry> read_log(const std::filesystem::path& path, LogReadReport* report = nullptr);
+/// Parses candump text (same rules as read_log; `file` names the source in errors).
+std::vector<LogEntry> parse_log(std::string_view text, const std::string& file = "<log>", LogReadReport* report = nullptr);
+/// Writes entries atomically (lash::AtomicFile) in the format of the extension.
 void write_log(const std::filesystem::path& path, const std::vector<LogEntry>& entries);
 
 }  // namespace lash::can

@@ -10,6 +10,7 @@
 
 #include "lash/blocks/side.hpp"
 #include "lash/identify/estimators.hpp"
+#include "lash/metrics/error.hpp"  // error_percent (was declared here)
 #include "lash/signals/signal.hpp"
 
 namespace lash {
@@ -43,8 +44,5 @@ struct ScenarioRun {
 
 /// Simulates the plant with the scenario's input and noise for `seed` and runs the estimator.
 ScenarioRun run_scenario(const ScenarioSpec& s, std::uint64_t seed);
-
-/// |estimate − truth| / |truth| in percent; NaN if the estimate is missing.
-double error_percent(double estimate, double truth) noexcept;
 
 }  // namespace lash

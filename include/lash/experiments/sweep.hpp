@@ -20,16 +20,15 @@ namespace lash::sweep {
 
 inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-/// What one run identified, per side, after the sweep's physical-sense checks.
+/// What one run identified, per side, with the estimator's verdict.
 struct SideResult {
   double a1 = kNaN, b1 = kNaN, c = kNaN;
   double gain = kNaN;    ///< K = b1/(1 + a1)
   double tau_s = kNaN;   ///< τ = −T/ln(−a1)
   bool identified = false;
   std::uint64_t updates = 0;
-  /// Why a side the estimator offered is reported not identified ("" when identified or when
-  /// the estimator itself said so): "unphysical deadzone" (c_r < 0, c_l > 0 or c_l > c_r),
-  /// "input not exciting" (the input took one value on every update: b1 and c inseparable).
+  /// The estimator's verdict when the side is not identified ("" when identified):
+  /// not_updated, not_excited, unstable, unphysical, poor_fit or wrong_guess (verdict.hpp).
   std::string rejected;
 };
 

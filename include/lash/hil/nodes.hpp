@@ -9,8 +9,12 @@
 /// - MasterNode ("Master Emulator", Fig 2.16): sends CRO until a DTO arrives, then
 ///   each step runs the SPEC B2 controller (discrete PID → deadzone inverse →
 ///   saturation 0–2000 mA) on the newest sensor frame and sends the command frame.
-///   Sensor frames missing for N periods (default 3) → 0 mA safe state, logged;
-///   control resumes when frames return.
+///
+/// Both check every frame they receive before acting on it (hil/e2e.hpp: DLC, CRC-8 SAE
+/// J1850, DBC range, alive counter): an implausible frame is counted per reason and dropped,
+/// never applied. Implausible or stale input drives the safe-state machine (NodeState below):
+/// the master freezes its PID and ramps to 0 mA, at N missed periods it commands 0 mA; the
+/// slave ramps the valve current to 0 mA and never drives outside 0–2000 mA.
 ///
 /// step() is the whole per-sample work of a node on the bus it is given. It is noexcept,
 /// allocation-free (logs are preallocated) and O(1) apart from draining at most
@@ -35,6 +39,7 @@
 #include "lash/can/bus.hpp"
 #include "lash/control/controller.hpp"
 #include "lash/hil/bench_layout.hpp"
+#include "lash/hil/e2e.hpp"
 #include "lash/rigs/pilot_valve_model.hpp"
 #include "lash/signals/signal.hpp"
 
@@ -43,29 +48,81 @@ namespace lash::hil {
 /// Most frames a node reads from the bus in one step; a babbling node cannot stretch a step further.
 inline constexpr std::size_t kMaxDrain = 64;
 
-/// Sequence-counter bookkeeping of one cyclic message (SPEC B3 heartbeat).
-/// late: frames that arrived after the step that should have used them (more than one
-/// new frame in a step); lost: counter values never seen; resyncs: counter jumps ≥ 1024
-/// or backwards (a restarted peer).
-struct SeqTracker {
-  bool have = false;
-  std::uint16_t last = 0;
-  std::uint64_t received = 0, late = 0, lost = 0, duplicates = 0, resyncs = 0;
-  std::uint32_t in_step = 0;
-
-  /// Returns true when the frame is newer than the last one seen.
-  bool on_frame(std::uint16_t counter) noexcept;
-  void end_step() noexcept {
-    if (in_step > 1) late += in_step - 1;
-    in_step = 0;
-  }
-  void forget() noexcept { have = false; }
-};
-
 /// A frame as a node saw it, for the candump log.
 struct LoggedFrame {
   can::Frame frame;
   bool sent = false;
+};
+
+/// The safe-state machine both nodes run (docs/hil.md has the diagram). Numbers are the
+/// `state` column of master.csv / slave.csv.
+///   startup   (0) master: CCP CONNECT sent, no reply yet (the slave waits before its loop)
+///   connected (1) handshake done, no plausible input yet: 0 mA
+///   running   (2) plausible, fresh input is applied
+///   degraded  (3) implausible input (or, slave: stale input): the master freezes its PID
+///                 (integrator included) and ramps its command to 0 mA; the slave ramps the
+///                 valve current to 0 mA — at E2EConfig::ramp_mA_per_s
+///   safe      (4) 0 mA: the ramp reached 0, or (master) no plausible sensor frame for
+///                 fault_missed_periods periods
+///   failed    (5) master: no CCP reply within dto_timeout_s
+/// degraded/safe → running after E2EConfig::recovery_frames good steps in a row (a step
+/// with a plausible new frame and no implausible one).
+enum class NodeState : std::uint8_t { startup, connected, running, degraded, safe, failed };
+const char* to_string(NodeState s) noexcept;
+using MasterState = NodeState;
+using SlaveState = NodeState;
+
+/// Every state transition (and the CCP handshake) is an event, logged with its step and time.
+enum class NodeEventKind : std::uint8_t {
+  connect_sent,          ///< master: first CCP CONNECT (startup)
+  connected,             ///< startup → connected (master: positive DTO; slave: CONNECT answered)
+  input_valid,           ///< connected → running: first plausible input
+  input_implausible,     ///< running → degraded: an implausible frame
+  input_stale,           ///< slave: running → degraded, no command for fault_missed_periods
+  ramp_done,             ///< degraded → safe: the current reached 0 mA
+  sensor_timeout,        ///< master: connected/running/degraded → safe, no sensor frame for N periods
+  input_recovered,       ///< degraded → running after recovery_frames good steps
+  input_resumed,         ///< safe → running after recovery_frames good steps
+  dto_timeout,           ///< master: startup → failed
+};
+const char* to_string(NodeEventKind k) noexcept;
+using MasterEventKind = NodeEventKind;
+
+struct NodeEvent {
+  std::uint32_t step = 0;   ///< loop step k
+  double t_s = 0.0;         ///< time the step ran [s] (slave's CONNECT: 0, before its first step)
+  NodeEventKind kind = NodeEventKind::connected;
+  NodeState from = NodeState::startup, to = NodeState::startup;
+};
+using MasterEvent = NodeEvent;
+
+/// Per-step bookkeeping of the safe-state machine's input, shared by both nodes.
+struct InputWatch {
+  std::uint32_t misses = 0;    ///< steps since the last plausible new frame
+  std::uint32_t good_run = 0;  ///< good steps in a row
+  void end_step(bool fresh, bool bad) noexcept {
+    misses = fresh ? 0 : misses + 1;
+    good_run = (fresh && !bad) ? good_run + 1 : 0;
+  }
+};
+
+/// Preallocated event log (no allocation in the step; overflow is counted).
+class EventLog {
+ public:
+  explicit EventLog(std::size_t capacity = 256) : events_(capacity) {}
+  void add(const NodeEvent& e) noexcept {
+    if (n_ < events_.size())
+      events_[n_++] = e;
+    else
+      ++dropped_;
+  }
+  std::span<const NodeEvent> events() const noexcept { return {events_.data(), n_}; }
+  std::uint64_t dropped() const noexcept { return dropped_; }
+
+ private:
+  std::vector<NodeEvent> events_;
+  std::size_t n_ = 0;
+  std::uint64_t dropped_ = 0;
 };
 
 // ----------------------------------------------------------------------------- slave
@@ -74,14 +131,20 @@ struct SlaveConfig {
   PilotValveParams plant;                 ///< SPEC B1 (dt_s = the step)
   std::vector<can::Frame> dto_reply;      ///< the recorded DTO frame(s), replayed on every CONNECT
   std::size_t log_capacity = 0;           ///< steps logged (preallocated)
+  E2EConfig e2e;                          ///< plausibility, recovery and ramp settings
+  std::uint32_t stale_periods = 3;        ///< steps without a plausible command → degraded
+  double current_min_mA = 0.0;            ///< the current driver's range: the output is clamped to it [mA]
+  double current_max_mA = 2000.0;
 };
 
 /// One slave step.
 struct SlaveStepLog {
   std::uint32_t step = 0;
-  std::uint16_t command_counter = 0;
-  bool command_fresh = false;             ///< a new command frame arrived for this step
-  double current_mA = 0.0;                ///< applied current (decoded from the bus)
+  SlaveState state = SlaveState::startup;
+  std::uint64_t command_counter = 0;      ///< the last accepted command's counter, unwrapped
+  bool command_fresh = false;             ///< a plausible new command frame arrived for this step
+  std::uint16_t dropped = 0;              ///< implausible command frames dropped in this step
+  double current_mA = 0.0;                ///< applied current (after ramp and clamp)
   double pressure_kPa = 0.0;              ///< noise-free plant pressure after apply
   double measured_kPa = 0.0;              ///< sensor reading (noise, sensor code)
   std::uint16_t pilot_raw = 0;            ///< bus value sent
@@ -89,16 +152,18 @@ struct SlaveStepLog {
 
 class SlaveNode {
  public:
-  /// Throws std::invalid_argument on an invalid plant or an empty DTO reply.
+  /// Throws std::invalid_argument on an invalid plant, an empty DTO reply or invalid E2E settings.
   SlaveNode(const BenchLayout& layout, SlaveConfig config);
 
   /// Handshake before the loop (not real-time): waits up to `timeout` for a CCP CONNECT,
   /// replays the DTO and returns true. timeout 0 polls what is queued.
   bool wait_connect(can::Bus& bus, std::chrono::nanoseconds timeout);
-  /// One step at time now_s (log only). noexcept, allocation-free.
+  /// One step at time now_s (log and events only). noexcept, allocation-free.
   void step(can::Bus& bus, double now_s) noexcept;
 
+  SlaveState state() const noexcept { return state_; }
   std::span<const SlaveStepLog> log() const noexcept { return {log_.data(), n_log_}; }
+  std::span<const NodeEvent> events() const noexcept { return events_.events(); }
   const SeqTracker& commands() const noexcept { return cmd_; }
   std::uint64_t frames_sent() const noexcept { return sent_; }
   std::uint64_t send_failures() const noexcept { return send_fail_; }
@@ -108,12 +173,17 @@ class SlaveNode {
 
  private:
   void reply_dto(can::Bus& bus) noexcept;
+  void go(SlaveState to, NodeEventKind why, double now_s) noexcept;
   BenchLayout layout_;
   SlaveConfig cfg_;
   PilotValvePlant plant_;
   SeqTracker cmd_;
-  double current_mA_ = 0.0;
-  std::uint16_t cmd_counter_ = 0;
+  InputWatch watch_;
+  EventLog events_;
+  SlaveState state_ = SlaveState::startup;
+  double command_mA_ = 0.0;   ///< last plausible command
+  double current_mA_ = 0.0;   ///< driven current
+  double ramp_step_mA_ = 0.0;
   std::uint32_t step_ = 0;
   std::uint64_t sent_ = 0, send_fail_ = 0, dto_replies_ = 0, ignored_ = 0;
   std::vector<SlaveStepLog> log_;
@@ -122,44 +192,35 @@ class SlaveNode {
 
 // ----------------------------------------------------------------------------- master
 
-enum class MasterState : std::uint8_t { connecting, running, fault, failed };
-const char* to_string(MasterState s) noexcept;
-
-enum class MasterEventKind : std::uint8_t { connect_sent, connected, sensor_timeout, sensor_resumed, dto_timeout };
-const char* to_string(MasterEventKind k) noexcept;
-
-struct MasterEvent {
-  std::uint32_t step = 0;   ///< loop step k
-  double t_s = 0.0;         ///< time the step ran [s]
-  MasterEventKind kind = MasterEventKind::connected;
-};
-
 struct MasterConfig {
   ControllerConfig controller;             ///< SPEC B2; controller.pid.dt_s = the step
   SignalSpec reference;                    ///< r(m), m = steps since the first CONNECT reply [kPa]
   double dto_timeout_s = 2.0;              ///< no DTO by then → failed (clear error)
-  std::uint32_t fault_missed_periods = 3;  ///< steps without a sensor frame → 0 mA safe state
-  std::uint32_t cro_retry_steps = 10;      ///< CRO repeat period while connecting / in fault [steps]
+  std::uint32_t fault_missed_periods = 3;  ///< steps without a plausible sensor frame → safe (0 mA)
+  std::uint32_t cro_retry_steps = 10;      ///< CRO repeat period while connecting / stale in safe [steps]
   std::size_t log_capacity = 0;            ///< steps logged (preallocated)
   std::size_t bus_log_capacity = 0;        ///< frames logged (preallocated); 0 → 4·log_capacity + 64
+  E2EConfig e2e;                           ///< plausibility, recovery and ramp settings
 };
 
 struct MasterStepLog {
   std::uint32_t step = 0;                  ///< loop step k
   std::int64_t control_step = -1;          ///< m (−1 before the first CONNECT reply)
-  MasterState state = MasterState::connecting;
+  MasterState state = MasterState::startup;
   double reference_kPa = 0.0;
   double measured_kPa = 0.0;               ///< decoded sensor (held when no fresh frame)
   std::uint16_t sensor_counter = 0;
-  bool sensor_fresh = false;
+  bool sensor_fresh = false;               ///< a plausible new sensor frame arrived for this step
+  std::uint16_t dropped = 0;               ///< implausible sensor frames dropped in this step
   double current_mA = 0.0;                 ///< commanded (before bus quantisation)
+  double integrator_mA = 0.0;              ///< the PID's integrator state after the step [mA]
   std::uint16_t command_counter = 0;
   bool command_sent = false;
 };
 
 class MasterNode {
  public:
-  /// Throws std::invalid_argument on an invalid controller or reference.
+  /// Throws std::invalid_argument on an invalid controller, reference or E2E settings.
   MasterNode(const BenchLayout& layout, MasterConfig config);
 
   /// One step at time now_s (log only). Returns false once the node has failed
@@ -170,7 +231,7 @@ class MasterNode {
   /// Control steps run so far (steps since the first CONNECT reply, fault steps included).
   std::int64_t control_steps() const noexcept { return m_ + 1; }
   std::span<const MasterStepLog> log() const noexcept { return {log_.data(), n_log_}; }
-  std::span<const MasterEvent> events() const noexcept { return {events_.data(), n_events_}; }
+  std::span<const NodeEvent> events() const noexcept { return events_.events(); }
   std::span<const LoggedFrame> bus_log() const noexcept { return {bus_log_.data(), n_bus_log_}; }
   std::uint64_t bus_log_dropped() const noexcept { return bus_log_dropped_; }
   const SeqTracker& sensors() const noexcept { return sens_; }
@@ -180,32 +241,33 @@ class MasterNode {
   double handshake_s() const noexcept { return handshake_s_; }  ///< first CRO → DTO [s]; −1 before
 
  private:
-  void event(MasterEventKind kind, double now_s) noexcept;
+  void go(MasterState to, NodeEventKind why, double now_s) noexcept;
   void send(can::Bus& bus, const can::Frame& f, double now_s) noexcept;
   void record(const can::Frame& f, bool sent) noexcept;
+  void control(can::Bus& bus, double r, double now_s) noexcept;
   BenchLayout layout_;
   MasterConfig cfg_;
   ClosedLoopDiscrete controller_;
   Signal reference_;
-  MasterState state_ = MasterState::connecting;
+  MasterState state_ = MasterState::startup;
   SeqTracker sens_;
+  InputWatch watch_;
+  EventLog events_;
+  bool fresh_ = false, bad_ = false;
   std::uint32_t k_ = 0;
   std::int64_t m_ = -1;
-  std::uint32_t misses_ = 0;
   std::uint32_t last_cro_k_ = 0;
   bool cro_sent_ = false;
   std::uint8_t cro_ctr_ = 0;
   double first_cro_s_ = -1.0, handshake_s_ = -1.0;
-  bool have_measurement_ = false;
   double measured_kPa_ = 0.0;
   std::uint16_t sensor_counter_ = 0;
   double current_mA_ = 0.0;
+  double ramp_step_mA_ = 0.0;
   std::uint16_t cmd_counter_ = 0;
   std::uint64_t sent_ = 0, send_fail_ = 0, ignored_ = 0;
   std::vector<MasterStepLog> log_;
   std::size_t n_log_ = 0;
-  std::vector<MasterEvent> events_;
-  std::size_t n_events_ = 0;
   std::vector<LoggedFrame> bus_log_;
   std::size_t n_bus_log_ = 0;
   std::uint64_t bus_log_dropped_ = 0;

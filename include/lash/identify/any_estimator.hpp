@@ -10,12 +10,17 @@
 #include <vector>
 
 #include "lash/identify/estimators.hpp"
+#include "lash/identify/intervals.hpp"
+#include "lash/metrics/fit.hpp"  // nrmse, outside_3sigma_per_1000 (were declared here)
 
 namespace lash {
 
 /// Summary of one side (or of the whole model for `linear`, kept in `right`).
 struct SideReport {
-  SideParams params;  ///< NaN = not identified (JSON null)
+  SideParams params;  ///< NaN = not identified (JSON null); params.identified/reason: the full verdict
+  double K = std::numeric_limits<double>::quiet_NaN();      ///< static gain b1/(1 + a1) [y unit / v unit]
+  double tau_s = std::numeric_limits<double>::quiet_NaN();  ///< time constant −T/ln(−a1) [s]
+  SideIntervals ci95;  ///< 95 % intervals (batch means, intervals.hpp); only when asked for
   std::vector<std::pair<std::string, std::uint64_t>> updates;  ///< per key: "+"/"-" or "all"
 };
 
@@ -30,6 +35,8 @@ struct EstimateReport {
   bool has_shared_d = false;   ///< coupled-carts: one d for both directions
   SideReport right, left;      ///< linear: only `right` is meaningful
   double d = std::numeric_limits<double>::quiet_NaN();  ///< coupled-carts
+  Reason d_reason = Reason::not_updated;                ///< coupled-carts: verdict of d
+  double fit_nrmse = std::numeric_limits<double>::quiet_NaN();  ///< the verdict's free-run NRMSE (fraction)
   std::vector<std::pair<std::string, std::uint64_t>> d_updates;
 };
 
@@ -52,8 +59,23 @@ class AnyEstimator {
   bool identified() const noexcept {
     return std::visit([](const auto& e) noexcept { return e.identified(); }, e_);
   }
-  /// Per-side parameters (linear: both sides return the single model).
-  SideParams params(Side s) const noexcept;
+  /// Per-side parameters with the update-time verdict (linear: both sides return the single model).
+  SideParams params(Side s) const noexcept {
+    return std::visit([s](const auto& e) noexcept { return e.params(s); }, e_);
+  }
+  /// The full verdict of a side (verdict.hpp); Reason::none = identified.
+  Reason verdict(Side s) const noexcept {
+    return std::visit([s](const auto& e) noexcept { return e.verdict(s); }, e_);
+  }
+  std::uint64_t skipped() const noexcept {
+    return std::visit([](const auto& e) noexcept { return e.skipped(); }, e_);
+  }
+  std::uint64_t samples() const noexcept { return samples_; }
+  /// Back to the state right after construction. Not real-time safe.
+  void reset() {
+    std::visit([](auto& e) { e.reset(); }, e_);
+    samples_ = 0;
+  }
 
   /// Names of the per-step parameter columns ("a1_r", "b1_r", "c_r", "d_r", …).
   std::vector<std::string> param_names() const;
@@ -84,12 +106,9 @@ struct EstimationRun {
 /// Steps `cfg`'s estimator through v, y (same length). keep_trace stores the parameters per step.
 EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> v, std::span<const double> y,
                             bool keep_trace = false);
-
-/// NRMSE = RMS(y − y_sim) / max|y| over t ∈ [t0, t1] (SPEC A6); NaN if the window is empty.
-double nrmse(std::span<const double> t, std::span<const double> y, std::span<const double> ysim, double t0_s,
-             double t1_s);
-/// Count per 1000 samples of |y − ŷ| > 3σ over t ∈ [t0, t1] (SPEC A6).
-double outside_3sigma_per_1000(std::span<const double> t, std::span<const double> y, std::span<const double> yhat,
-                               double sigma, double t0_s, double t1_s);
+/// Adds the 95 % intervals of every identified side's parameters to run.report (batch means,
+/// intervals.hpp: runs the estimator once more over sections of the same record).
+void add_intervals(EstimationRun& run, const EstimatorConfig& cfg, std::span<const double> v,
+                   std::span<const double> y);
 
 }  // namespace lash

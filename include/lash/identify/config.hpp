@@ -94,6 +94,13 @@ struct EstimatorConfig {
   /// Free-run simulation inside the input deadzone: false = keep the a1 of the side last used
   /// (thesis §1.4.2, SPEC A4); true = side by the sign of v(k−1) (eq. 34).
   bool sim_side_by_sign = false;
+  /// Verdict check 6 (verdict.hpp): a model whose free-run NRMSE (RMS(y − y_sim)/max|y|) over
+  /// t ≥ fit_start_s exceeds this fraction is reported `poor_fit`. 0.2 = 20 %: far above what
+  /// measurement noise alone gives on a fitting model (E2, noise variance 200: about 1.5 %).
+  double fit_threshold = 0.2;
+  /// Start of the verdict's fit window [s] (the whole record when it ends earlier); 7.5 s is
+  /// the thesis's NRMSE window start and `lash estimate`'s default --nrmse-window.
+  double fit_start_s = 7.5;
 
   /// Throws std::invalid_argument naming the field.
   void validate() const;

@@ -15,41 +15,23 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 
 #include "lash/blocks/side.hpp"
 #include "lash/identify/config.hpp"
 #include "lash/identify/preprocess.hpp"
 #include "lash/identify/rls.hpp"
+#include "lash/identify/verdict.hpp"
+#include "lash/metrics/fit.hpp"
 
 namespace lash {
-
-/// Identified parameters of one side; NaN = not identified / not part of the model.
-struct SideParams {
-  double a1 = std::numeric_limits<double>::quiet_NaN();
-  double b1 = std::numeric_limits<double>::quiet_NaN();
-  double c = std::numeric_limits<double>::quiet_NaN();
-  double d = std::numeric_limits<double>::quiet_NaN();
-  bool identified = false;
-};
 
 namespace detail {
 inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double deadzone(double x, double cl, double cr) noexcept {
   return x > cr ? x - cr : (x < cl ? x - cl : 0.0);
 }
-constexpr int side_index(Side s) noexcept { return s == Side::right ? 0 : 1; }
-/// The range of the values one regressor took (excitation check: a constant input makes b1 and
-/// the offset e inseparable — only b1·v + e is determined).
-struct ValueRange {
-  double lo = std::numeric_limits<double>::infinity();
-  double hi = -std::numeric_limits<double>::infinity();
-  void add(double x) noexcept {
-    lo = std::min(lo, x);
-    hi = std::max(hi, x);
-  }
-  /// More than one value (beyond rounding) was seen.
-  bool several() const noexcept { return hi - lo > 1e-9 * std::max(1.0, std::max(std::fabs(hi), std::fabs(lo))); }
-};
+using ValueRange = verdict_rules::ValueRange;
 /// Fixed ring of the last 64 values (instrument history).
 struct History {
   std::array<double, 64> buf{};
@@ -58,27 +40,65 @@ struct History {
   /// j = 1 → last pushed value.
   double ago(std::size_t j) const noexcept { return buf[(pos - static_cast<unsigned>(j)) & 63u]; }
 };
+/// The one free-run side choice of the two-sided models: right above the right edge, left below
+/// the left edge, otherwise (inside the deadzone) the side last used (thesis §1.4.2, SPEC A4);
+/// by_sign: the side of the sign of x (eq. 34).
+constexpr Side free_run_side(double x, const PerSide<double>& edge, Side last, bool by_sign = false) noexcept {
+  if (by_sign) return side_of(x);
+  return x > edge.right ? Side::right : (x < edge.left ? Side::left : last);
+}
+/// Input-side switching (eq. 18): right when v(k−1) > c_r*, left when v(k−1) < c_l*, none inside.
+constexpr std::optional<Side> guess_side(double v1, const EstimatorConfig& c) noexcept {
+  if (v1 > c.guess_right) return Side::right;
+  if (v1 < c.guess_left) return Side::left;
+  return std::nullopt;
+}
+/// Free-run fit of a model (verdict check 6): NRMSE of y_sim against y over t ≥ fit_start_s, or
+/// over every sample when the record ends before that.
+struct FitWindow {
+  std::uint64_t k0 = 0, k = 0;
+  NrmseAccumulator window, all;
+  void add(double y, double ysim) noexcept {
+    all.add(y, ysim);
+    if (k++ >= k0) window.add(y, ysim);
+  }
+  double nrmse() const noexcept { return window.n > 0 ? window.value() : all.value(); }
+};
 }  // namespace detail
 
 /// Linear first-order model (eq. 9–12): φ = [−y(k−1), v(k−1)], η = [a1, b1]; every sample updates.
+/// The verdict is that of the whole model (reported on Side::right and Side::left alike).
 class LinearEstimator {
  public:
   explicit LinearEstimator(const EstimatorConfig& cfg);
-  /// Advances one sample; returns ŷ(k) = φᵀη̂(k−1) (eq. 14).
+  /// Advances one sample; returns ŷ(k) = φᵀη̂(k−1) (eq. 14). A non-finite sample changes nothing
+  /// but the skip count (ŷ = NaN).
   double step(double v, double y) noexcept;
   double prediction() const noexcept { return yhat_; }
   double simulated() const noexcept { return ysim_; }
+  /// a1, b1 with the update-time verdict (checks 1–5 of verdict.hpp); NaN while not identified.
   SideParams params() const noexcept;
+  SideParams params(Side) const noexcept { return params(); }
+  /// The full verdict (checks 1–6): what reports show.
+  Reason verdict(Side = Side::right) const noexcept;
   std::uint64_t updates() const noexcept { return rls_.updates(); }
+  std::uint64_t updates(Side) const noexcept { return rls_.updates(); }
   std::uint64_t skipped() const noexcept { return skipped_ + rls_.skipped(); }
-  bool identified() const noexcept { return rls_.updates() >= cfg_.min_updates; }
+  bool identified() const noexcept { return verdict() == Reason::none; }
+  /// NRMSE of the free run y_sim against y (verdict check 6, a fraction).
+  double fit_nrmse() const noexcept { return fit_.nrmse(); }
   const Rls<2>& rls() const noexcept { return rls_; }
+  const EstimatorConfig& config() const noexcept { return cfg_; }
+  /// Back to the state right after construction. Not real-time safe (reallocates the filters).
+  void reset() { *this = LinearEstimator(cfg_); }
 
  private:
   EstimatorConfig cfg_;
   Preprocessor pre_;
   Rls<2> rls_;
   detail::History hist_;
+  detail::ValueRange vrange_, yrange_;
+  detail::FitWindow fit_;
   double y1_ = 0.0, v1_ = 0.0, vraw1_ = 0.0, x_ = 0.0;
   double yhat_ = 0.0, ysim_ = 0.0;
   std::uint64_t skipped_ = 0;
@@ -92,29 +112,34 @@ class TwoSideEstimator {
  public:
   double prediction() const noexcept { return yhat_; }
   double simulated() const noexcept { return ysim_; }
-  SideParams params(Side s) const noexcept { return p_[side_index(s)]; }
-  std::uint64_t updates(Side s) const noexcept { return rls_[side_index(s)].updates(); }
-  std::uint64_t skipped() const noexcept { return skipped_ + rls_[0].skipped() + rls_[1].skipped(); }
-  bool identified() const noexcept { return p_[0].identified && p_[1].identified; }
-  const Rls<3>& rls(Side s) const noexcept { return rls_[side_index(s)]; }
+  SideParams params(Side s) const noexcept { return p_[s]; }
+  Reason verdict(Side s) const noexcept;
+  std::uint64_t updates(Side s) const noexcept { return rls_[s].updates(); }
+  std::uint64_t skipped() const noexcept { return skipped_ + rls_.right.skipped() + rls_.left.skipped(); }
+  bool identified() const noexcept { return verdict(Side::right) == Reason::none && verdict(Side::left) == Reason::none; }
+  double fit_nrmse() const noexcept { return fit_.nrmse(); }
+  const Rls<3>& rls(Side s) const noexcept { return rls_[s]; }
+  const EstimatorConfig& config() const noexcept { return cfg_; }
 
  protected:
   explicit TwoSideEstimator(const EstimatorConfig& cfg);
-  /// Side i after an update, with its deadzone edge c (NaN when the model cannot give one) and
-  /// the model's own plausibility test of c. The free run holds the side's last stable set
-  /// (finite, |a1| < 1); the side is identified only if also c_r ≥ 0 ≥ c_l and plausible.
-  void refresh(int i, double c, bool plausible) noexcept;
-  /// Updates side i's RLS with φ = [−y(k−1), v(k−1), 1] (or its instrument); returns ŷ.
-  double update(int i, double y) noexcept;
+  /// Side s after an update, with its deadzone edge c (NaN when the model cannot give one) and
+  /// whether c lies inside the switching guesses. The free run holds the side's last stable set
+  /// (finite, |a1| < 1); the verdict (verdict.hpp) decides whether the side is identified.
+  void refresh(Side s, double c, bool guess_ok) noexcept;
+  /// Updates side s's RLS with φ = [−y(k−1), v(k−1), 1] (or its instrument); returns ŷ.
+  double update(Side s, double y) noexcept;
 
   EstimatorConfig cfg_;
   Preprocessor pre_;
-  std::array<Rls<3>, 2> rls_;
-  std::array<SideParams, 2> p_{};
-  std::array<double, 2> sa1_{}, sb1_{}, sc_{};  // parameters used by the free-run simulation
+  PerSide<Rls<3>> rls_;
+  PerSide<SideParams> p_{};
+  PerSide<double> sa1_{}, sb1_{}, sc_{};  // parameters used by the free-run simulation
+  PerSide<ValueRange> vrange_{}, yrange_{};  // v(k−1), y(k−1) over each side's updates
   History hist_;
+  FitWindow fit_;
   double y1_ = 0.0, v1_ = 0.0, vraw1_ = 0.0;
-  int sim_last_ = 0;
+  Side sim_last_ = Side::right;
   double yhat_ = 0.0, ysim_ = 0.0;
   std::uint64_t skipped_ = 0;
 };
@@ -126,11 +151,12 @@ class InputDeadzoneEstimator : public detail::TwoSideEstimator {
  public:
   explicit InputDeadzoneEstimator(const EstimatorConfig& cfg);
   double step(double v, double y) noexcept;
+  void reset() { *this = InputDeadzoneEstimator(cfg_); }
 
  private:
-  void refresh(int i) noexcept;
+  void refresh(Side s) noexcept;
   double w_ = 0.0;
-  int last_ = 0;
+  Side last_ = Side::right;
 };
 
 /// Output deadzone (§1.6.1, eq. 36, motor cart): side r when y(k) > 0 and y(k−1) > 0,
@@ -139,9 +165,10 @@ class OutputDeadzoneEstimator : public detail::TwoSideEstimator {
  public:
   explicit OutputDeadzoneEstimator(const EstimatorConfig& cfg);
   double step(double v, double y) noexcept;
+  void reset() { *this = OutputDeadzoneEstimator(cfg_); }
 
  private:
-  void refresh(int i) noexcept;
+  void refresh(Side s) noexcept;
   double x_ = 0.0;
 };
 
@@ -153,98 +180,61 @@ class OutputDeadzoneEstimator : public detail::TwoSideEstimator {
 class DeadzoneDeadbandEstimator {
  public:
   enum Key : int { right_plus = 0, right_minus = 1, left_plus = 2, left_minus = 3 };
+  static constexpr Key key(Side s, bool plus) noexcept {
+    return static_cast<Key>((s == Side::right ? 0 : 2) + (plus ? 0 : 1));
+  }
 
   explicit DeadzoneDeadbandEstimator(const EstimatorConfig& cfg);
-
-  double step(double v, double y) noexcept {
-    if (!(std::isfinite(v) && std::isfinite(y))) {
-      ++skipped_;
-      return yhat_ = detail::kNaN;
-    }
-    const Conditioned s = pre_.step(v, y);
-    const int dir = direction(s.ydot, cfg_.noise.derivative_threshold);
-    const double y1 = y1_, v1 = v1_;
-    const int side = v1 > cfg_.guess_right ? 0 : (v1 < cfg_.guess_left ? 1 : -1);
-    run_ = (dir != 0 && dir == dir1_ && side == side1_) ? run_ + 1 : 1;
-    side1_ = side;
-    if (side >= 0 && dir != 0 && run_ >= cfg_.direction_run) {
-      const int key = side * 2 + (dir > 0 ? 0 : 1);
-      if (cfg_.pooled) {
-        const double sg = dir > 0 ? -1.0 : 1.0;
-        const std::array<double, 4> phi{-y1, v1, 1.0, sg};
-        if (cfg_.method == EstimationMethod::iv)
-          yhat_ = pooled_[side].update_iv(phi, {-hist_.ago(1 + cfg_.iv_delay), v1, 1.0, sg}, s.y);
-        else
-          yhat_ = pooled_[side].update(phi, s.y);
-        ++count_[key];
-      } else {
-        const std::array<double, 3> phi{-y1, v1, 1.0};
-        if (cfg_.method == EstimationMethod::iv)
-          yhat_ = rls_[key].update_iv(phi, {-hist_.ago(1 + cfg_.iv_delay), v1, 1.0}, s.y);
-        else
-          yhat_ = rls_[key].update(phi, s.y);
-        count_[key] = rls_[key].updates();
-      }
-      // Derived (a1, b1, c, d) are refreshed on every update until the side is identified, then
-      // every 4th update (the free run lags at most 3 samples; params() is always current).
-      if (!p_[side].identified || (++since_[side] & 3u) == 0) refresh(side);
-      last_ = side;
-    } else {
-      yhat_ = predict_free(side >= 0 ? side : last_, y1, v1);
-    }
-    hist_.push(s.y);
-    y1_ = s.y;
-    v1_ = s.v;
-    dir1_ = dir;
-    simulate(v);
-    return yhat_;
-  }
+  double step(double v, double y) noexcept;
+  void reset() { *this = DeadzoneDeadbandEstimator(cfg_); }
 
   double prediction() const noexcept { return yhat_; }
   double simulated() const noexcept { return ysim_; }
   /// Current parameters (computed from the four/two RLS on each call).
   SideParams params(Side s) const noexcept;
+  Reason verdict(Side s) const noexcept;
   /// Updates of key (side, +) or (side, −).
-  std::uint64_t updates(Side s, bool plus) const noexcept {
-    return count_[detail::side_index(s) * 2 + (plus ? 0 : 1)];
-  }
+  std::uint64_t updates(Side s, bool plus) const noexcept { return count_[key(s, plus)]; }
+  /// Updates of the side (both directions).
+  std::uint64_t updates(Side s) const noexcept { return count_[key(s, true)] + count_[key(s, false)]; }
   std::uint64_t skipped() const noexcept;
-  bool identified() const noexcept { return p_[0].identified && p_[1].identified; }
+  bool identified() const noexcept { return verdict(Side::right) == Reason::none && verdict(Side::left) == Reason::none; }
+  double fit_nrmse() const noexcept { return fit_.nrmse(); }
+  const EstimatorConfig& config() const noexcept { return cfg_; }
   /// Raw [a1, b1, e] of one key (separate-RLS mode).
   const Rls<3>& rls(Key k) const noexcept { return rls_[k]; }
   /// The 4-parameter regression of one side (pooled mode).
-  const Rls<4>& pooled_rls(Side s) const noexcept { return pooled_[detail::side_index(s)]; }
+  const Rls<4>& pooled_rls(Side s) const noexcept { return pooled_[s]; }
 
  private:
-  SideParams derive(int side) const noexcept;
-  void refresh(int side) noexcept;
-  double predict_free(int side, double y1, double v1) const noexcept;
-  void simulate(double v) noexcept {
-    int s;
-    if (cfg_.sim_side_by_sign) s = vraw1_ >= 0.0 ? 0 : 1;
-    else s = vraw1_ > sc_[0] ? 0 : (vraw1_ < sc_[1] ? 1 : sim_last_);
-    sim_last_ = s;
-    const double u = detail::deadzone(vraw1_, sc_[1], sc_[0]);
-    w_ = -sa1_[s] * w_ + sb1_[s] * u;
-    const double d = sd_[s];
-    if (w_ < ysim_ - d) ysim_ = w_ + d;
-    else if (w_ > ysim_ + d) ysim_ = w_ - d;
-    vraw1_ = v;
-  }
+  /// A side's raw parameters with their update-time verdict, and whether they may drive the
+  /// free run (the method's own premise; see derive()).
+  struct Derived {
+    SideParams p;
+    bool usable = false;
+  };
+  Derived derive(Side s) const noexcept;
+  void refresh(Side s) noexcept;
+  double predict_free(Side s, double y1, double v1) const noexcept;
+  void simulate(double v) noexcept;
 
   EstimatorConfig cfg_;
   Preprocessor pre_;
   std::array<Rls<3>, 4> rls_;
-  std::array<Rls<4>, 2> pooled_;
+  PerSide<Rls<4>> pooled_;
   std::array<std::uint64_t, 4> count_{};
-  std::array<SideParams, 2> p_{};
-  std::array<double, 2> sa1_{}, sb1_{}, sc_{}, sd_{};
-  std::array<double, 2> prev_c_{}, prev_d_{};
-  std::array<std::uint32_t, 2> settled_{};
-  std::array<std::uint32_t, 2> since_{};
+  PerSide<bool> usable_{};
+  PerSide<double> sa1_{}, sb1_{}, sc_{}, sd_{};
+  PerSide<double> prev_c_{}, prev_d_{};
+  PerSide<std::uint32_t> settled_{};
+  PerSide<std::uint32_t> since_{};
+  PerSide<detail::ValueRange> vrange_{}, yrange_{};
   detail::History hist_;
+  detail::FitWindow fit_;
   double y1_ = 0.0, v1_ = 0.0, vraw1_ = 0.0, w_ = 0.0;
-  int dir1_ = 0, last_ = 0, sim_last_ = 0, side1_ = -1;
+  int dir1_ = 0;
+  Side last_ = Side::right, sim_last_ = Side::right;
+  std::optional<Side> side1_;
   std::uint32_t run_ = 0;
   double yhat_ = 0.0, ysim_ = 0.0;
   std::uint64_t skipped_ = 0;
@@ -255,47 +245,56 @@ class DeadzoneDeadbandEstimator {
 /// while the pin is engaged and 0 inside the position deadband.
 /// Stage 1: output-deadzone velocity model (eq. 38) updated on samples where the free cart
 /// has moved in one direction for three samples (so ẏ(k), ẏ(k−1) are both ẇ) and
-/// |ÿ| ≤ accel_limit. A side is identified when it has min_updates updates, −1 < a1 < 0, c on
-/// its own side of zero (c_r ≥ 0 ≥ c_l) and the input took more than one value on its updates.
-/// Stage 2 (t ≥ stage2_start_s, both sides identified): the free-run velocity model is
+/// |ÿ| ≤ accel_limit. A side is identified when the verdict (verdict.hpp) says so, with
+/// −1 < a1 < 0 required (a positive time constant).
+/// Stage 2 (t ≥ stage2_start_s, both sides usable): the free-run velocity model is
 /// integrated to ŵ; engaged, y − ŵ = o ∓ d (moving ±). o drifts (ŵ is an open-loop integral),
 /// so d is taken per slot crossing: when the free cart starts moving the other way, y − ŵ has
 /// changed by ±2d since its last moving sample. d = mean over crossings (available after the
-/// first); o = least-squares offset given d. The free run uses only identified parameter sets
-/// (the last one per side); a side never identified predicts no motion.
+/// first); o = least-squares offset given d. The free run uses only usable parameter sets
+/// (the last one per side: enough updates, −1 < a1 < 0, c on its side of zero, input
+/// exciting); a side never usable predicts no motion.
 class CoupledCartsEstimator {
  public:
   explicit CoupledCartsEstimator(const EstimatorConfig& cfg);
   double step(double v, double y) noexcept;
+  void reset() { *this = CoupledCartsEstimator(cfg_); }
   double prediction() const noexcept { return yhat_; }
   double simulated() const noexcept { return ysim_; }
   /// Velocity model per side (a1, b1, c) and the shared deadband half-width d.
   SideParams params(Side s) const noexcept;
+  Reason verdict(Side s) const noexcept;
   double deadband() const noexcept;
-  std::uint64_t updates(Side s) const noexcept { return rls_[detail::side_index(s)].updates(); }
+  /// Verdict of the shared deadband: not_updated before the first slot crossing, unphysical if d < 0.
+  Reason deadband_reason() const noexcept;
+  std::uint64_t updates(Side s) const noexcept { return rls_[s].updates(); }
   /// Stage-2 slot crossings that ended moving + (plus = true) or −.
   std::uint64_t deadband_updates(bool plus) const noexcept { return dcount_[plus ? 0 : 1]; }
   std::uint64_t skipped() const noexcept;
   bool identified() const noexcept;
+  double fit_nrmse() const noexcept { return fit_.nrmse(); }
+  const EstimatorConfig& config() const noexcept { return cfg_; }
   /// Simulated motor-cart velocity ŵ̇ and position ŵ (+ offset).
   double simulated_velocity() const noexcept { return wdot_; }
 
  private:
-  void refresh(int i) noexcept;
+  void refresh(Side s) noexcept;
   EstimatorConfig cfg_;
   Preprocessor pre_;
-  std::array<Rls<3>, 2> rls_;
+  PerSide<Rls<3>> rls_;
   std::array<std::uint64_t, 2> dcount_{};  // stage-2 crossings ending in motion + / −
   double dsum_ = 0.0, r_last_ = 0.0, osum_ = 0.0, odir_ = 0.0;
   std::uint64_t on_ = 0;
   int dir_last_ = 0;
   bool r_ok_ = false;
-  std::array<SideParams, 2> p_{};
-  std::array<double, 2> sa1_{}, sb1_{}, sc_{};  // last identified set per side (free run)
-  std::array<bool, 2> valid_{};                   // side identified at least once
-  std::array<detail::ValueRange, 2> vrange_{};  // v(k−1) over each side's updates
+  PerSide<SideParams> p_{};
+  PerSide<double> sa1_{}, sb1_{}, sc_{};  // last usable set per side (free run)
+  PerSide<bool> valid_{};                   // side usable at least once
+  PerSide<detail::ValueRange> vrange_{}, yrange_{};  // v(k−1), velocity(k−1) over each side's updates
+  detail::FitWindow fit_;
   double vel1_ = 0.0, v1_ = 0.0, vraw1_ = 0.0, y1_ = 0.0;
-  int dir1_ = 0, dir2_ = 0, sim_last_ = 0;
+  int dir1_ = 0, dir2_ = 0;
+  Side sim_last_ = Side::right;
   double x_ = 0.0, wdot_ = 0.0, w_ = 0.0, ydb_ = 0.0;
   std::uint64_t k_ = 0, stage2_k_ = 0;
   double yhat_ = 0.0, ysim_ = 0.0;

@@ -31,6 +31,9 @@ namespace lash::rt {
 std::int64_t monotonic_ns() noexcept;
 /// Sleeps until the absolute CLOCK_MONOTONIC time `t_ns` (restarts after EINTR unless `stop` is set).
 void sleep_until_ns(std::int64_t t_ns, const std::atomic<bool>* stop = nullptr) noexcept;
+/// Switches the calling thread to SCHED_FIFO `priority` (1–99). Returns "" on success,
+/// else why it was refused (the thread keeps its scheduler).
+std::string use_fifo(int priority);
 
 enum class OverrunPolicy : std::uint8_t { tolerate, stop };
 

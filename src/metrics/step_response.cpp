@@ -1,4 +1,4 @@
-#include "lash/control/step_metrics.hpp"
+#include "lash/metrics/step_response.hpp"
 
 #include <cmath>
 #include <limits>

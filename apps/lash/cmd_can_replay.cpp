@@ -1,0 +1,81 @@
+// lash can replay | convert: parse, call lash::can, print.
+#include <memory>
+
+#include <fmt/core.h>
+
+#include "cmd_can.hpp"
+#include "lash/can/bus.hpp"
+#include "lash/can/log.hpp"
+#include "lash/can/replay.hpp"
+
+namespace lash::cli::can_cmd {
+namespace {
+
+struct ReplayArgs {
+  std::string bus;
+  std::string log;
+  double speed = 1.0;
+  double spin_us = 2000.0;
+  int rt_priority = 0;
+};
+
+int run_replay(const ReplayArgs& a) {
+  const auto entries = read_log_reporting(a.log, "replay");
+  auto bus = can::open_bus(a.bus);
+  can::ReplayOptions o;
+  o.speed = a.speed;
+  o.spin_ns = static_cast<std::int64_t>(a.spin_us * 1e3);
+  o.fifo_priority = a.rt_priority;
+  install_stop_handler();
+  const auto r = can::replay(*bus, entries, o, g_stop);
+  if (!r.warning.empty()) fmt::print(stderr, "lash can replay: {}; continuing without\n", r.warning);
+  if (r.interrupted) fmt::print(stderr, "lash can replay: stopped by a signal after {} of {} frames\n", r.sent + r.failed, entries.size());
+  if (r.failed) {
+    fmt::print(stderr, "lash can replay: {} of {} frames failed to send\n", r.failed, entries.size());
+    return kExitFailed;
+  }
+  return kExitOk;
+}
+
+struct ConvertArgs {
+  std::string in;
+  std::string out;
+};
+
+int run_convert(const ConvertArgs& a) {
+  const auto entries = read_log_reporting(a.in, "convert");
+  can::write_log(a.out, entries);
+  fmt::print(stderr, "lash can convert: {} frames, {} -> {}\n", entries.size(), can::to_string(can::log_format_of(a.in)),
+             can::to_string(can::log_format_of(a.out)));
+  return kExitOk;
+}
+
+}  // namespace
+
+std::vector<can::LogEntry> read_log_reporting(const std::string& path, const char* who) {
+  can::LogReadReport report;
+  auto entries = can::read_log(path, &report);
+  for (const auto& p : report.problems) fmt::print(stderr, "lash can {}: dropped: {}\n", who, p);
+  if (report.dropped)
+    fmt::print(stderr, "lash can {}: {} of {} records of {} dropped\n", who, report.dropped, report.dropped + entries.size(), path);
+  return entries;
+}
+
+std::vector<Sub> add_replay_command(CLI::App& sub) {
+  auto rep = std::make_shared<ReplayArgs>();
+  auto* r = sub.add_subcommand("replay", "Send the frames of a log (.asc, .blf, .trc, candump) with their original timing (stops at SIGINT/SIGTERM)");
+  r->add_option("--bus", rep->bus, "Bus address")->required();
+  r->add_option("--speed", rep->speed, "Time scale, 1e-6..1e6 (2 = twice as fast)")->check(CLI::Range(1e-6, 1e6))->capture_default_str();
+  r->add_option("--spin-us", rep->spin_us, "Busy-wait this long before each deadline [us], 0..1e6")
+      ->check(CLI::Range(0.0, 1e6))->capture_default_str();
+  r->add_option("--rt-priority", rep->rt_priority, "Run under SCHED_FIFO with this priority (1-99; 0 = default scheduler; needs privileges)")
+      ->check(CLI::Range(0, 99))->capture_default_str();
+  r->add_option("log", rep->log, "Log file: .asc, .blf, .trc or candump")->required();
+  auto conv = std::make_shared<ConvertArgs>();
+  auto* c = sub.add_subcommand("convert", "Convert a log between candump (-L), Vector ASC (.asc), Vector BLF (.blf) and PEAK TRC (.trc), by extension");
+  c->add_option("in", conv->in, "Log to read")->required()->check(CLI::ExistingFile);
+  c->add_option("out", conv->out, "Log to write (written atomically)")->required();
+  return {{r, [=] { return run_replay(*rep); }}, {c, [=] { return run_convert(*conv); }}};
+}
+
+}  // namespace lash::cli::can_cmd

@@ -1,0 +1,52 @@
+#pragma once
+/// @file intervals.hpp
+/// 95 % confidence intervals of identified parameters by **batch means** (sectioning: Schmeiser,
+/// "Batch size effects in the analysis of simulation output", Oper. Res. 30(3), 1982; Law &
+/// Kelton, Simulation Modeling and Analysis, §9.5.3). Not real-time code (runs the estimator again).
+///
+/// The record is cut into B consecutive sections; the same estimator runs on each section alone.
+/// With the section estimates θ_1 … θ_B (those whose side the estimator identified), their
+/// standard deviation s and the memory m of the estimator (m = min(length, 1/(1 − λ)); λ = 1:
+/// the length), the standard error of the whole-record estimate θ is s·√(m_section / m_record)
+/// and the interval θ ± t_{0.975, B'−1} · SE (Student's t for the B' sections used).
+/// Why not σ²·P: with filtered v and y (the moving averages of SPEC A5) the equation error is
+/// correlated over the filter length, and with instrumental variables P is not a covariance;
+/// sections see both effects as they are. K and τ get their own section estimates (not a
+/// linearisation). An interval needs at least 5 identified sections; otherwise it is absent
+/// (NaN bounds, JSON null).
+#include <cstddef>
+#include <limits>
+#include <span>
+
+#include "lash/blocks/side.hpp"
+#include "lash/identify/config.hpp"
+#include "lash/identify/verdict.hpp"
+
+namespace lash {
+
+struct Interval {
+  double lo = std::numeric_limits<double>::quiet_NaN();
+  double hi = std::numeric_limits<double>::quiet_NaN();
+  bool valid() const noexcept { return lo <= hi; }
+};
+
+/// 95 % intervals of one side's parameters (a parameter the model lacks stays invalid).
+struct SideIntervals {
+  Interval a1, b1, c, d, K, tau_s;
+};
+
+struct IntervalSettings {
+  std::size_t sections = 10;      ///< B
+  std::size_t min_sections = 5;   ///< fewer identified sections → no interval
+};
+
+/// Intervals around `estimate` (the whole-record parameters per side; coupled carts: the shared d
+/// in both sides' d). Throws std::invalid_argument when v and y differ in length.
+PerSide<SideIntervals> batch_means_intervals(const EstimatorConfig& cfg, std::span<const double> v,
+                                             std::span<const double> y, const PerSide<SideParams>& estimate,
+                                             const IntervalSettings& s = {});
+
+/// Student's t quantile t_{0.975, dof} for dof ≥ 1 (table to 30, then the normal-limit series).
+double student_t975(std::size_t dof) noexcept;
+
+}  // namespace lash

@@ -1,0 +1,102 @@
+#pragma once
+/// @file verdict.hpp
+/// The one decision "is this side identified, and if not, why" (issue 12 item 4), used by every
+/// estimator of SPEC A4; `lash estimate`, `lash sweep` and library users read it from the
+/// estimator (`params(s).reason`, `verdict(s)`), never re-decide it.
+///
+/// A side (for the linear model: the model) is identified only when, in this order,
+///  1. it was updated enough (`min_updates` per key; deadzone-deadband: (c, d) also settled)
+///     — else `not_updated`;
+///  2. it was excited: the input v(k−1) and the output regressor y(k−1) each took more than one
+///     value over the side's updates (a constant v makes b1 and the offset inseparable, a
+///     constant y leaves a1 undetermined), and the information matrix P⁻¹ of its RLS is well
+///     conditioned (checked by `verdict()`, see `well_conditioned`) — else `not_excited`;
+///  3. it is stable: finite and |a1| < 1 — else `unstable`;
+///  4. it is physical: b1 > 0, the deadzone edge on its own side of zero (c_r ≥ 0 ≥ c_l:
+///     friction, spring pretension or spool overlap contain zero, thesis §1.6.1), the deadband
+///     half-width d ≥ 0 (coupled carts also −1 < a1 < 0: a positive time constant) — else
+///     `unphysical`;
+///  5. the switching guesses were right: an input-side model's edge lies inside its guesses,
+///     c_l* < c < c_r* (eq. 18) — else `wrong_guess` (the side's guess is inside the deadzone);
+///  6. the model fits: the free-run NRMSE of the whole model over its fit window is at most
+///     `fit_threshold` (checked by `verdict()`) — else `poor_fit`.
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+
+#include "lash/blocks/side.hpp"
+
+namespace lash {
+
+enum class Reason : std::uint8_t { none, not_updated, not_excited, unstable, unphysical, poor_fit, wrong_guess };
+
+/// "none", "not_updated", "not_excited", "unstable", "unphysical", "poor_fit", "wrong_guess".
+const char* to_string(Reason r) noexcept;
+
+/// Identified parameters of one side; NaN = not identified / not part of the model.
+struct SideParams {
+  double a1 = std::numeric_limits<double>::quiet_NaN();
+  double b1 = std::numeric_limits<double>::quiet_NaN();
+  double c = std::numeric_limits<double>::quiet_NaN();
+  double d = std::numeric_limits<double>::quiet_NaN();
+  bool identified = false;
+  Reason reason = Reason::not_updated;  ///< none when identified
+};
+
+namespace verdict_rules {
+
+/// The deadzone edge c of `s` lies on its own side of zero: c_r ≥ 0, c_l ≤ 0.
+constexpr bool physical_edge(double c, Side s) noexcept { return s == Side::right ? c >= 0.0 : c <= 0.0; }
+
+/// The range of the values one regressor took (excitation check).
+struct ValueRange {
+  double lo = std::numeric_limits<double>::infinity();
+  double hi = -std::numeric_limits<double>::infinity();
+  void add(double x) noexcept {
+    lo = std::min(lo, x);
+    hi = std::max(hi, x);
+  }
+  /// More than one value (beyond rounding) was seen.
+  bool several() const noexcept { return hi - lo > 1e-9 * std::max(1.0, std::max(std::fabs(hi), std::fabs(lo))); }
+};
+
+/// What the update-time checks (1–5) see of one side.
+struct Evidence {
+  Side side = Side::right;
+  bool updated = false;        ///< enough updates (and, where the model asks, settled)
+  bool excited = false;        ///< v(k−1) and y(k−1) took more than one value; no singular solve
+  double a1 = std::numeric_limits<double>::quiet_NaN();
+  double b1 = std::numeric_limits<double>::quiet_NaN();
+  bool has_c = false;          ///< the model has a deadzone edge (then c must be finite)
+  double c = std::numeric_limits<double>::quiet_NaN();
+  bool has_d = false;          ///< the model has a deadband half-width on this side
+  double d = std::numeric_limits<double>::quiet_NaN();
+  bool negative_a1 = false;    ///< coupled carts: also −1 < a1 < 0 (a positive time constant)
+  bool guess_ok = true;        ///< input-side models: c_l* < c < c_r*
+};
+
+/// Checks 1–5 in order; Reason::none when all pass. noexcept, O(1).
+Reason judge(const Evidence& e) noexcept;
+
+/// Condition test of the information matrix P⁻¹ of an RLS (check 2, not on the sample path:
+/// O(N³), no allocation). cond(P⁻¹) = cond(P): P (symmetrised) scaled to unit diagonal must have
+/// its smallest eigenvalue above `kMinScaledEigenvalue` (1e-10) — exactly or nearly collinear
+/// regressors (a correlation beyond 1 − 1e-10) fail.
+template <std::size_t N>
+bool well_conditioned(const std::array<std::array<double, N>, N>& P) noexcept;
+
+inline constexpr double kMinScaledEigenvalue = 1e-10;
+
+/// Checks 1–6 from the update-time reason, the information condition and the model's fit.
+/// A NaN fit (no sample in the window, or y ≡ 0 there) is no evidence against the side.
+constexpr Reason finish(Reason update_time, bool conditioned, double fit_nrmse, double fit_threshold) noexcept {
+  if (update_time != Reason::none) return update_time;
+  if (!conditioned) return Reason::not_excited;
+  if (fit_nrmse > fit_threshold) return Reason::poor_fit;
+  return Reason::none;
+}
+
+}  // namespace verdict_rules
+}  // namespace lash

@@ -1,0 +1,100 @@
+#include "lash/identify/intervals.hpp"
+
+#include <array>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+#include "lash/identify/any_estimator.hpp"
+#include "lash/metrics/first_order.hpp"
+
+namespace lash {
+
+double student_t975(std::size_t dof) noexcept {
+  // t_{0.975, n}, n = 1 … 30 (any statistics table; scipy.stats.t.ppf(0.975, n))
+  static constexpr std::array<double, 30> t{12.7062047, 4.30265273, 3.18244631, 2.77644511, 2.57058184, 2.44691185,
+                                            2.36462425, 2.30600414, 2.26215716, 2.22813885, 2.20098516, 2.17881283,
+                                            2.16036866, 2.14478669, 2.13144955, 2.11990530, 2.10981558, 2.10092204,
+                                            2.09302405, 2.08596345, 2.07961384, 2.07387307, 2.06865761, 2.06389856,
+                                            2.05953855, 2.05552944, 2.05183052, 2.04840714, 2.04522964, 2.04227246};
+  if (dof == 0) return std::numeric_limits<double>::infinity();
+  if (dof <= t.size()) return t[dof - 1];
+  // Cornish–Fisher expansion around z = 1.959964 (Abramowitz & Stegun 26.7.5, three terms):
+  // within 1e-6 of the exact quantile for n > 30
+  const double z = 1.959963984540054, n = static_cast<double>(dof);
+  const double z3 = z * z * z, z5 = z3 * z * z, z7 = z5 * z * z;
+  return z + (z3 + z) / (4 * n) + (5 * z5 + 16 * z3 + 3 * z) / (96 * n * n) +
+         (3 * z7 + 19 * z5 + 17 * z3 - 15 * z) / (384 * n * n * n);
+}
+
+namespace {
+/// Memory of the estimator over `n` samples: exponential forgetting keeps about 1/(1 − λ).
+double memory(const EstimatorConfig& c, std::size_t n) {
+  const double len = static_cast<double>(n);
+  return c.rls.lambda < 1.0 ? std::min(len, 1.0 / (1.0 - c.rls.lambda)) : len;
+}
+
+Interval around(double centre, const std::vector<double>& xs, double scale, std::size_t min_n) {
+  Interval iv;
+  if (!std::isfinite(centre) || xs.size() < min_n || xs.size() < 2) return iv;
+  double mean = 0.0;
+  for (double x : xs) mean += x;
+  mean /= static_cast<double>(xs.size());
+  double ss = 0.0;
+  for (double x : xs) ss += (x - mean) * (x - mean);
+  const double sd = std::sqrt(ss / static_cast<double>(xs.size() - 1));
+  const double half = student_t975(xs.size() - 1) * sd * scale;
+  if (!std::isfinite(half)) return iv;
+  iv.lo = centre - half;
+  iv.hi = centre + half;
+  return iv;
+}
+}  // namespace
+
+PerSide<SideIntervals> batch_means_intervals(const EstimatorConfig& cfg, std::span<const double> v,
+                                             std::span<const double> y, const PerSide<SideParams>& estimate,
+                                             const IntervalSettings& s) {
+  if (v.size() != y.size()) throw std::invalid_argument("v and y differ in length");
+  PerSide<SideIntervals> out;
+  const std::size_t n = v.size(), B = s.sections;
+  if (B < 2 || n / B < 2) return out;
+  const std::size_t len = n / B;
+  // per side, per parameter: the section estimates of identified sides
+  struct Samples {
+    std::vector<double> a1, b1, c, d, K, tau;
+  };
+  PerSide<Samples> sm;
+  AnyEstimator est(cfg);
+  for (std::size_t b = 0; b < B; ++b) {
+    est.reset();
+    for (std::size_t k = b * len; k < (b + 1) * len; ++k) est.step(v[k], y[k]);
+    for (Side side : {Side::right, Side::left}) {
+      const SideParams p = est.params(side);
+      if (!p.identified) continue;
+      Samples& q = sm[side];
+      q.a1.push_back(p.a1);
+      q.b1.push_back(p.b1);
+      if (std::isfinite(p.c)) q.c.push_back(p.c);
+      if (std::isfinite(p.d)) q.d.push_back(p.d);
+      q.K.push_back(static_gain(p.a1, p.b1));
+      const double tau = time_constant_s(p.a1, cfg.dt_s);
+      if (std::isfinite(tau)) q.tau.push_back(tau);
+    }
+  }
+  const double scale = std::sqrt(memory(cfg, len) / memory(cfg, n));
+  for (Side side : {Side::right, Side::left}) {
+    const SideParams& e = estimate[side];
+    const Samples& q = sm[side];
+    SideIntervals& r = out[side];
+    const std::size_t m = s.min_sections;
+    r.a1 = around(e.a1, q.a1, scale, m);
+    r.b1 = around(e.b1, q.b1, scale, m);
+    r.c = around(e.c, q.c, scale, m);
+    r.d = around(e.d, q.d, scale, m);
+    r.K = around(static_gain(e.a1, e.b1), q.K, scale, m);
+    r.tau_s = around(time_constant_s(e.a1, cfg.dt_s), q.tau, scale, m);
+  }
+  return out;
+}
+
+}  // namespace lash
