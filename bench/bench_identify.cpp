@@ -5,6 +5,8 @@
 #include <cmath>
 #include <vector>
 
+#include "lash/identify/auto.hpp"
+#include "lash/identify/auto_gate.hpp"
 #include "lash/identify/estimators.hpp"
 #include "lash/identify/rls.hpp"
 #include "lash/plant/plant.hpp"
@@ -64,20 +66,36 @@ void BM_DeadzoneDeadband(benchmark::State& s) {
 BENCHMARK(BM_DeadzoneDeadband);
 
 void BM_DeadzoneDeadbandE2Settings(benchmark::State& s) {
-  auto c = thesis(lash::ModelKind::deadzone_deadband);
-  c.pooled = true;
-  c.method = lash::EstimationMethod::iv;
-  c.iv_delay = 45;
-  c.direction_run = 41;
-  c.rls.lambda = 1.0;
-  c.noise.filter_length = 40;
-  c.noise.filter_input = true;
-  c.noise.derivative_filter_length = 20;
-  c.noise.derivative_threshold = 150;
-  c.noise.align_delay = 10;
+  // E2's method (config/scenarios/e2.toml) = lash's static default for the model
+  auto c = lash::preset_config(lash::ModelKind::deadzone_deadband, lash::Preset::lash, 0.005);
+  c.guess_left = -350;
+  c.guess_right = 350;
   run<lash::DeadzoneDeadbandEstimator>(s, c);
 }
 BENCHMARK(BM_DeadzoneDeadbandE2Settings);
+
+// What `lash estimate rec.csv --model deadzone-deadband` runs per sample: lash's settings tuned to
+// the record (lash::tune_to_data), the guesses searched (lash::search_guesses, done once before),
+// and the outlier gate in front of the estimator.
+void BM_DeadzoneDeadbandDefault(benchmark::State& state) {
+  const Data& d = e1_data();
+  auto c = lash::preset_config(lash::ModelKind::deadzone_deadband, lash::Preset::lash, 0.005);
+  lash::tune_to_data(c, lash::analyse_record(d.v, d.y, 0.005));
+  const auto g = lash::search_guesses(c, d.v, d.y);
+  c.guess_right = g[0];
+  c.guess_left = g[1];
+  lash::DeadzoneDeadbandEstimator est(c);
+  lash::OutlierGate gate;
+  const std::size_t mask = d.v.size() - 1;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    double yhat = est.step(d.v[i], gate.step(d.y[i]));
+    benchmark::DoNotOptimize(yhat);
+    i = (i + 1) & mask;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_DeadzoneDeadbandDefault);
 
 void BM_InputDeadzone(benchmark::State& s) {
   run<lash::InputDeadzoneEstimator>(s, thesis(lash::ModelKind::input_deadzone));

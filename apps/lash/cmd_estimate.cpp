@@ -2,15 +2,19 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <optional>
 
 #include <unistd.h>
 
 #include <fmt/core.h>
+#include <nlohmann/json.hpp>
 
 #include "cli_common.hpp"
-#include "plot.hpp"
+#include "estimate_plot.hpp"
+#include "estimate_settings.hpp"
 #include "lash/identify/any_estimator.hpp"
+#include "lash/identify/auto.hpp"
 #include "lash/identify/estimate_report.hpp"
 #include "lash/identify/config_file.hpp"
 #include "lash/identify/data.hpp"
@@ -18,117 +22,88 @@
 namespace lash::cli {
 namespace {
 
-struct EstimateOptions {
-  std::string data;
-  std::string model;
-  std::string config;
-  std::optional<double> guess_left, guess_right, lambda, p0, derivative_threshold;
-  std::optional<std::size_t> filter_length, derivative_filter_length, derivative_prefilter_length, input_delay,
-      align_delay, direction_run, min_updates, iv_delay;
-  std::optional<std::string> method, forgetting;
-  bool filter_input = false, pooled = false;
-  std::optional<double> accel_limit, stage2_start, zero_threshold;
-  std::string columns;
-  std::vector<double> nrmse_window;
-  std::string out;
-  std::string plot;
-  bool json = false;
-  bool strict = false;
-  bool timing = false;
-};
+nlohmann::ordered_json num(double x) { return std::isfinite(x) ? nlohmann::ordered_json(x) : nlohmann::ordered_json(); }
 
-std::vector<std::string> split_names(const std::string& text) {
-  std::vector<std::string> out;
-  std::size_t start = 0;
-  while (true) {
-    const auto end = text.find(',', start);
-    out.push_back(text.substr(start, end == std::string::npos ? std::string::npos : end - start));
-    if (end == std::string::npos) break;
-    start = end + 1;
+/// What estimate_auto adds to a side: the guess it used, and wrong_guess when it lay inside the deadzone.
+void put_guess(nlohmann::ordered_json& j, const GuessReport& g) {
+  if (g.source == GuessSource::unused) return;
+  if (g.wrong_side) j["reason"] = "wrong_guess";
+  j["guess"] = {{"value", num(g.guess)}, {"source", to_string(g.source)}, {"edge_seen", num(g.edge)}};
+}
+
+/// The final 95 % intervals by trace column name ("a1_r", "c_l", "d", …) for the plot's bands.
+std::map<std::string, std::pair<double, double>> ci95_columns(const EstimateReport& r) {
+  std::map<std::string, std::pair<double, double>> m;
+  const auto put = [&](const std::string& name, const Interval& iv) {
+    if (iv.valid()) m[name] = {iv.lo, iv.hi};
+  };
+  if (r.model == ModelKind::linear) {
+    put("a1", r.right.ci95.a1);
+    put("b1", r.right.ci95.b1);
+    return m;
   }
-  for (const auto& n : out)
-    if (n.empty()) throw InputError("", 0, "--columns", "empty column name in '" + text + "'");
-  if (out.size() != 3) throw InputError("", 0, "--columns", "expected three names t,v,y, got '" + text + "'");
-  return out;
+  for (const auto& [sfx, s] : {std::pair{"_r", &r.right}, std::pair{"_l", &r.left}}) {
+    put(std::string("a1") + sfx, s->ci95.a1);
+    put(std::string("b1") + sfx, s->ci95.b1);
+    put(std::string("c") + sfx, s->ci95.c);
+    put(std::string("d") + sfx, s->ci95.d);
+  }
+  return m;
 }
 
 int run(const EstimateOptions& o) {
-  EstimatorConfig cfg;
-  EstimationJob job;
-  if (!o.config.empty()) {
-    const toml::table root = parse_toml_file(o.config);
-    TomlTable t(root, o.config);
-    read_estimator_config(t, cfg, &job);
+  Preset preset{};
+  try {
+    preset = parse_preset(o.preset);
+  } catch (const std::invalid_argument& e) {
+    throw InputError("", 0, "--preset", e.what());
   }
+  ModelKind model{};
   if (!o.model.empty()) {
     try {
-      cfg.model = parse_model_kind(o.model);
+      model = parse_model_kind(o.model);
     } catch (const std::invalid_argument& e) {
       throw InputError("", 0, "--model", e.what());
     }
-  } else if (o.config.empty()) {
+  } else if (!o.config.empty()) {
+    EstimatorConfig probe;
+    EstimationJob j;
+    const toml::table root = parse_toml_file(o.config);
+    TomlTable t(root, o.config);
+    (void)t.string_opt("preset");
+    read_estimator_config(t, probe, &j);
+    model = probe.model;
+  } else {
     throw InputError("", 0, "--model", "give --model (or a --config with model = ...)");
   }
-  if (o.guess_left) cfg.guess_left = *o.guess_left;
-  if (o.guess_right) cfg.guess_right = *o.guess_right;
-  if (o.lambda) cfg.rls.lambda = *o.lambda;
-  if (o.p0) cfg.rls.p0 = *o.p0;
-  if (o.filter_length) cfg.noise.filter_length = *o.filter_length;
-  if (o.filter_input) cfg.noise.filter_input = true;
-  if (o.derivative_filter_length) cfg.noise.derivative_filter_length = *o.derivative_filter_length;
-  if (o.derivative_prefilter_length) cfg.noise.derivative_prefilter_length = *o.derivative_prefilter_length;
-  if (o.derivative_threshold) cfg.noise.derivative_threshold = *o.derivative_threshold;
-  if (o.input_delay) cfg.noise.input_delay = *o.input_delay;
-  if (o.align_delay) cfg.noise.align_delay = *o.align_delay;
-  if (o.direction_run) cfg.direction_run = static_cast<std::uint32_t>(*o.direction_run);
-  if (o.min_updates) cfg.min_updates = *o.min_updates;
-  if (o.iv_delay) cfg.iv_delay = *o.iv_delay;
-  if (o.pooled) cfg.pooled = true;
-  if (o.accel_limit) cfg.accel_limit = *o.accel_limit;
-  if (o.stage2_start) cfg.stage2_start_s = *o.stage2_start;
-  if (o.zero_threshold) cfg.zero_threshold = *o.zero_threshold;
-  if (o.method) {
-    try {
-      cfg.method = parse_method(*o.method);
-    } catch (const std::invalid_argument& e) {
-      throw InputError("", 0, "--method", e.what());
-    }
-  }
-  if (o.forgetting) {
-    if (*o.forgetting == "exponential") cfg.rls.forgetting = Forgetting::exponential;
-    else if (*o.forgetting == "directional") cfg.rls.forgetting = Forgetting::directional;
-    else throw InputError("", 0, "--forgetting", "expected exponential or directional");
-  }
-  if (!o.columns.empty()) job.columns = split_names(o.columns);
-  if (!o.nrmse_window.empty()) {
-    if (o.nrmse_window.size() != 2 || !(o.nrmse_window[0] < o.nrmse_window[1]))
-      throw InputError("", 0, "--nrmse-window", "expected T0 T1 with T0 < T1 [s]");
-    job.nrmse_t0_s = o.nrmse_window[0];
-    job.nrmse_t1_s = o.nrmse_window[1];
-  }
+  // an option the model does not read is refused, never ignored
+  for (const auto& name : o.given)
+    if (!model_uses(model, name))
+      throw InputError("", 0, "--" + name, std::string("model ") + to_string(model) + " does not use this option");
   // settings are checked before the data is read, so a bad option never costs a file scan
-  cfg.dt_s = 1.0;
-  try {
-    cfg.validate();
-  } catch (const std::invalid_argument& e) {
-    throw InputError(o.config, 0, "", e.what());
-  }
+  EstimationJob job;
+  (void)assemble(o, model, preset, nullptr, job);
 
   const Record rec = load_record(o.data, job.columns, o.strict);
-  cfg.dt_s = rec.dt_s;
+  EstimatorConfig cfg = assemble(o, model, preset, &rec, job);
   cfg.fit_start_s = job.nrmse_t0_s;  // the verdict's fit window starts where the reported NRMSE's does
   const bool keep = !o.out.empty() || !o.plot.empty();
   const auto t_start = std::chrono::steady_clock::now();
-  EstimationRun run = run_estimator(cfg, rec.v(), rec.y(), keep);
+  AutoRun ar = estimate_auto(cfg, rec.v(), rec.y(), keep, o.outlier_gate);
+  EstimationRun& run = ar.run;
   const double elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   if (o.timing)
     fmt::print(stderr, "lash estimate: estimator ran {} samples in {} s ({:.3g} M samples/s)\n", rec.v().size(),
                format_double(elapsed_s), static_cast<double>(rec.v().size()) / elapsed_s * 1e-6);
-  add_intervals(run, cfg, rec.v(), rec.y());
+  add_intervals(run, ar.cfg, rec.v(), rec.y());
   const auto& t = rec.t();
   const double t1 = job.nrmse_t1_s < 0 ? t.back() : job.nrmse_t1_s;
   const double fit = nrmse(t, rec.y(), run.ysim, job.nrmse_t0_s, t1);
 
+  if (o.print_config) {
+    fmt::print("{}", config_to_toml(ar.cfg));
+    return kExitOk;
+  }
   if (!o.out.empty()) {
     std::vector<std::string> names{"t", "y", "yhat", "y_sim"};
     std::vector<const std::vector<double>*> cols{&t, &rec.y(), &run.yhat, &run.ysim};
@@ -152,19 +127,11 @@ int run(const EstimateOptions& o) {
       }
       write_columns_csv(csv, names, cols);
     }
-    std::vector<PlotPanel> panels{{"output", "t [s]"}, {"a1, b1", "t [s]"}};
-    std::vector<PlotSeries> series{{"t", "y", "y measured", 0}, {"t", "y_sim", "y simulated", 0}};
-    bool cd_panel = false;
-    for (const auto& n : run.param_names) {
-      const bool lin = n.rfind("a1", 0) == 0 || n.rfind("b1", 0) == 0;
-      if (!lin) cd_panel = true;
-      series.push_back({"t", n, n, lin ? 1 : 2});
-    }
-    if (cd_panel) panels.push_back({"c, d", "t [s]"});
     try {
-      plot_csv(csv, o.plot, fmt::format("lash estimate --model {} {}", to_string(cfg.model),
-                                        std::filesystem::path(o.data).filename().string()),
-               panels, series);
+      plot_estimate(csv, o.plot,
+                    fmt::format("lash estimate --model {} {}", to_string(cfg.model),
+                                std::filesystem::path(o.data).filename().string()),
+                    run.param_names, t.back(), ci95_columns(run.report));
     } catch (...) {
       if (!tmp.empty()) std::filesystem::remove(tmp);
       throw;
@@ -174,8 +141,24 @@ int run(const EstimateOptions& o) {
 
   const ReportFit rf{fit, job.nrmse_t0_s, t1, rec.skipped_rows(), rec.data.first_skipped_line, rec.gap_rows().size(),
                      rec.sampling.median_dt};
-  if (o.json) fmt::print("{}\n", estimate_json(run.report, rf));
-  else fmt::print("{}", estimate_text(run.report, rec.dt_s, rf));
+  if (o.json) {
+    auto j = nlohmann::ordered_json::parse(estimate_json(run.report, rf));
+    if (j.contains("right")) put_guess(j["right"], ar.right);
+    if (j.contains("left")) put_guess(j["left"], ar.left);
+    j["outliers"] = ar.outliers;
+    j["preset"] = to_string(preset);
+    fmt::print("{}\n", j.dump());
+  } else {
+    fmt::print("{}", estimate_text(run.report, rec.dt_s, rf));
+    for (const auto& [name, g] : {std::pair{"right", ar.right}, std::pair{"left", ar.left}}) {
+      if (g.wrong_side)
+        fmt::print("wrong_guess: the {} guess {:.6g} lies inside the deadzone (edge seen at {:.6g})\n", name, g.guess,
+                   g.edge);
+      else if (g.source != GuessSource::unused)
+        fmt::print("{} guess: {:.6g} ({})\n", name, g.guess, to_string(g.source));
+    }
+    if (ar.outliers > 0) fmt::print("outliers: {} samples of y replaced by the outlier gate\n", ar.outliers);
+  }
   return kExitOk;
 }
 
@@ -217,13 +200,26 @@ Command add_estimate(CLI::App& app) {
       ->expected(2);
   sub->add_option("-o,--output", o->out, "Trace CSV: t, y, yhat, y_sim and every parameter per step");
   sub->add_option("--plot", o->plot, "PNG of parameter convergence and measured vs simulated output");
+  sub->add_option("--preset", o->preset, "lash (default: lash's best settings, tuned to the data) | thesis");
+  sub->add_flag("--print-config", o->print_config,
+                "Print the settings actually used (TOML, readable by --config) instead of the result");
+  sub->add_option("--outlier-gate", o->outlier_gate,
+                  "Replace isolated outliers of y beyond this many innovation scales (0 = off; default 12)");
   sub->add_flag("--json", o->json, "Print exactly one JSON object with the result on stdout");
   sub->add_flag("--timing", o->timing, "Print the estimator's own run time (without file I/O) on stderr");
   // a later option overrides an earlier one (handy for wrappers that append settings)
   for (auto* opt : sub->get_options())
     if (opt->get_expected_max() == 1 && opt->get_name() != "--nrmse-window")
       opt->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
-  return {sub, [o] { return run(*o); }};
+  return {sub, [o, sub] {
+            o->given.clear();
+            o->preset_given = sub->get_option("--preset")->count() > 0;
+            for (const char* n : {"guess-left", "guess-right", "pooled", "direction-run", "method", "iv-delay",
+                                  "accel-limit", "stage2-start", "zero-threshold", "derivative-threshold",
+                                  "derivative-filter-length", "derivative-prefilter-length", "align-delay"})
+              if (sub->get_option(std::string("--") + n)->count() > 0) o->given.emplace_back(n);
+            return run(*o);
+          }};
 }
 
 }  // namespace lash::cli

@@ -1,5 +1,6 @@
 #include "lash/experiments/campaign.hpp"
 
+#include "lash/identify/auto.hpp"
 #include "lash/identify/config_file.hpp"
 
 #include <cmath>
@@ -28,8 +29,18 @@ std::vector<double> nonempty_numbers(TomlTable& t, const char* key, bool positiv
 }
 
 /// The `[estimator]` table: exactly the layout of `lash estimate --config` files
-/// (lash::read_estimator_config, docs/identification.md), then validated as a whole.
-void read_estimator(TomlTable& t, EstimatorConfig& e) {
+/// (lash::read_estimator_config, docs/identification.md) over lash's settings for the rig, or over
+/// the thesis's with `preset = "thesis"`; then validated as a whole.
+void read_estimator(TomlTable& t, EstimatorConfig& e, rigs::RigKind kind) {
+  if (auto p = t.string_opt("preset")) {
+    Preset preset{};
+    try {
+      preset = parse_preset(*p);
+    } catch (const std::invalid_argument& ex) {
+      t.fail("preset", ex.what());
+    }
+    e = preset == Preset::thesis ? thesis_estimator(kind, e.dt_s) : lash_estimator(kind, e.dt_s);
+  }
   read_estimator_config(t, e);
   try {
     e.validate();
@@ -62,6 +73,10 @@ EstimatorConfig thesis_estimator(rigs::RigKind kind, double dt_s) {
       break;
   }
   return e;
+}
+
+EstimatorConfig lash_estimator(rigs::RigKind kind, double dt_s) {
+  return preset_config(thesis_estimator(kind, dt_s).model, Preset::lash, dt_s);
 }
 
 Campaign load_campaign(const std::filesystem::path& path) {
@@ -159,9 +174,10 @@ Campaign load_campaign(const std::filesystem::path& path) {
     c.runs[i].seed = run_seed(c.seed, i);
   }
 
-  c.estimator = thesis_estimator(kind, c.dt_s);
+  c.estimator = lash_estimator(kind, c.dt_s);
+  c.estimator_from_data = !root.has("estimator");
   if (auto e = root.table_opt("estimator")) {
-    read_estimator(*e, c.estimator);
+    read_estimator(*e, c.estimator, kind);
     // The models each rig's runner drives: one output, a deadzone on either side of the linear
     // part (cart, valve), or the two-stage coupled-carts model.
     const ModelKind m = c.estimator.model;

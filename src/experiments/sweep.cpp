@@ -9,6 +9,7 @@
 #include <mutex>
 #include <thread>
 
+#include "lash/identify/auto.hpp"
 #include "lash/metrics/error.hpp"
 #include "lash/metrics/first_order.hpp"
 #include "lash/metrics/fit.hpp"
@@ -111,17 +112,60 @@ RunResult finish(const Campaign& c, const RunSpec& r, const Est& est, const Scor
 /// A single-output rig with the input- or output-deadzone estimator, as the campaign says
 /// (load_campaign admits no other model for these rigs).
 template <class Rig>
-RunResult run_deadzone_model(const Campaign& c, const RunSpec& r, Rig& rig, Signal& sig, std::size_t n, Score& score,
-                             std::vector<TraceRow>* trace) {
+RunResult run_deadzone_model(const Campaign& c, const EstimatorConfig& ec, const RunSpec& r, Rig& rig, Signal& sig,
+                             std::size_t n, Score& score, std::vector<TraceRow>* trace) {
   auto same = [](double y) { return std::pair<double, double>{y, y}; };
-  if (c.estimator.model == ModelKind::output_deadzone) {
-    OutputDeadzoneEstimator est(c.estimator);
+  if (ec.model == ModelKind::output_deadzone) {
+    OutputDeadzoneEstimator est(ec);
     drive(est, rig, same, SimOut{}, sig, n, score, c.dt_s, trace);
     return finish(c, r, est, score);
   }
-  InputDeadzoneEstimator est(c.estimator);
+  InputDeadzoneEstimator est(ec);
   drive(est, rig, same, SimOut{}, sig, n, score, c.dt_s, trace);
   return finish(c, r, est, score);
+}
+
+/// The rig's open-loop record of run r (v(k), the y the estimator would see): the rig does not
+/// depend on the estimator, so the settings can be taken from it before the run itself.
+template <class Rig, class Measure>
+void record_run(const Campaign& c, const RunSpec& r, Measure measure, std::vector<double>& v,
+                std::vector<double>& y) {
+  Signal sig(signal_of(c, r), c.dt_s);
+  const std::size_t n = sample_count(c.duration_s, c.dt_s);
+  Rig rig = [&] {
+    if constexpr (std::is_same_v<Rig, rigs::MotorCart>) return Rig(c.rig.motor_cart, c.dt_s, r.seed);
+    else if constexpr (std::is_same_v<Rig, rigs::PilotValveRig>) return Rig(c.rig.pilot_valve, c.dt_s, r.seed);
+    else return Rig(c.rig.coupled_carts, c.dt_s, r.seed);
+  }();
+  auto out = rig.initial_output();
+  v.resize(n);
+  y.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    v[k] = sig.next();
+    y[k] = measure(out).first;
+    out = rig.step(v[k]);
+  }
+}
+
+/// Settings of run r: the campaign's, or (no [estimator] table) lash's tuned to the run's record.
+EstimatorConfig settings_for(const Campaign& c, const RunSpec& r) {
+  if (!c.estimator_from_data) return c.estimator;
+  std::vector<double> v, y;
+  auto same = [](double x) { return std::pair<double, double>{x, x}; };
+  auto pos = [](const rigs::CoupledCartsSample& s) { return std::pair<double, double>{s.position_m, s.velocity_m_s}; };
+  switch (c.rig.kind) {
+    case rigs::RigKind::motor_cart: record_run<rigs::MotorCart>(c, r, same, v, y); break;
+    case rigs::RigKind::pilot_valve: record_run<rigs::PilotValveRig>(c, r, same, v, y); break;
+    case rigs::RigKind::coupled_carts: record_run<rigs::CoupledCarts>(c, r, pos, v, y); break;
+  }
+  EstimatorConfig e = c.estimator;
+  tune_to_data(e, analyse_record(v, y, c.dt_s));
+  if (std::isinf(e.guess_left) || std::isinf(e.guess_right)) {
+    const auto g = search_guesses(e, v, y);
+    if (std::isinf(e.guess_right)) e.guess_right = g[0];
+    if (std::isinf(e.guess_left)) e.guess_left = g[1];
+  }
+  return e;
 }
 
 }  // namespace
@@ -132,19 +176,19 @@ RunResult run_one(const Campaign& c, const RunSpec& r, std::vector<TraceRow>* tr
   Score score;
   score.k0 = index_at(c.window_start_s, c.dt_s);
   score.k1 = std::min(n - 1, index_at(c.window_end_s, c.dt_s));
-  const EstimatorConfig& ec = c.estimator;
+  const EstimatorConfig ec = settings_for(c, r);
   RunResult out;
   switch (c.rig.kind) {
     case rigs::RigKind::motor_cart: {
       rigs::MotorCart rig(c.rig.motor_cart, c.dt_s, r.seed);
-      out = run_deadzone_model(c, r, rig, sig, n, score, trace);
+      out = run_deadzone_model(c, ec, r, rig, sig, n, score, trace);
       out.truth = rig.effective();
       score_params(out, true);
       break;
     }
     case rigs::RigKind::pilot_valve: {
       rigs::PilotValveRig rig(c.rig.pilot_valve, c.dt_s, r.seed);
-      out = run_deadzone_model(c, r, rig, sig, n, score, trace);
+      out = run_deadzone_model(c, ec, r, rig, sig, n, score, trace);
       out.truth = c.rig.pilot_valve.effective(c.dt_s, 0.0);
       score_params(out, false);
       break;

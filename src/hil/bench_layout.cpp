@@ -40,7 +40,10 @@ void BenchLayout::refresh_checks() noexcept {
 }
 
 std::uint8_t BenchLayout::e2e_crc(const can::Frame& f, const BitField& crc) noexcept {
-  const std::size_t at = crc.signal().start_bit / 8;
+  return e2e_crc(f, crc.signal().start_bit / 8);
+}
+
+std::uint8_t BenchLayout::e2e_crc(const can::Frame& f, std::size_t at) noexcept {
   std::uint8_t reg = Crc8SaeJ1850::kInit;
   reg = Crc8SaeJ1850::update(reg, static_cast<std::uint8_t>(f.id & 0xFFu));
   reg = Crc8SaeJ1850::update(reg, static_cast<std::uint8_t>((f.id >> 8) & 0xFFu));
@@ -51,26 +54,42 @@ std::uint8_t BenchLayout::e2e_crc(const can::Frame& f, const BitField& crc) noex
   return Crc8SaeJ1850::finish(reg);
 }
 
-std::optional<Drop> BenchLayout::check_command(const can::Frame& f) const noexcept {
+std::optional<Drop> BenchLayout::check_command(const can::Frame& f, CommandMsg& out) const noexcept {
   if (f.remote || f.len != command_len) return Drop::dlc;
   const std::uint64_t w = load_le(f);
   const Checks& c = checks;
-  if (c.command_crc.get(command_crc, f, w) != e2e_crc(f, command_crc)) return Drop::crc;
-  if (!c.solenoid_a.in_range(c.solenoid_a.get(solenoid_a, f, w)) ||
-      !c.solenoid_b.in_range(c.solenoid_b.get(solenoid_b, f, w)) ||
-      !c.restrictor.in_range(c.restrictor.get(restrictor, f, w)))
-    return Drop::range;
+  if (c.command_crc.get(command_crc, f, w) != e2e_crc(f, c.command_crc.shift / 8)) return Drop::crc;
+  const std::uint64_t a = c.solenoid_a.get(solenoid_a, f, w), b = c.solenoid_b.get(solenoid_b, f, w),
+                      r = c.restrictor.get(restrictor, f, w);
+  if (!c.solenoid_a.in_range(a) || !c.solenoid_b.in_range(b) || !c.restrictor.in_range(r)) return Drop::range;
+  out.solenoid_a_mA = solenoid_a.to_physical(a);
+  out.solenoid_b_mA = solenoid_b.to_physical(b);
+  out.restrictor_mA = restrictor.to_physical(r);
+  out.counter = static_cast<std::uint16_t>(c.command_counter.get(command_counter, f, w));
   return std::nullopt;
 }
 
-std::optional<Drop> BenchLayout::check_sensors(const can::Frame& f) const noexcept {
+std::optional<Drop> BenchLayout::check_sensors(const can::Frame& f, SensorMsg& out) const noexcept {
   if (f.remote || f.len != sensors_len) return Drop::dlc;
   const std::uint64_t w = load_le(f);
   const Checks& c = checks;
-  if (c.sensors_crc.get(sensors_crc, f, w) != e2e_crc(f, sensors_crc)) return Drop::crc;
-  if (!c.pilot.in_range(c.pilot.get(pilot, f, w)) || !c.supply.in_range(c.supply.get(supply, f, w)))
-    return Drop::range;
+  if (c.sensors_crc.get(sensors_crc, f, w) != e2e_crc(f, c.sensors_crc.shift / 8)) return Drop::crc;
+  const std::uint64_t p = c.pilot.get(pilot, f, w), s = c.supply.get(supply, f, w);
+  if (!c.pilot.in_range(p) || !c.supply.in_range(s)) return Drop::range;
+  out.pilot_raw = static_cast<std::uint16_t>(p);
+  out.supply_raw = static_cast<std::uint16_t>(s);
+  out.counter = static_cast<std::uint16_t>(c.sensor_counter.get(sensor_counter, f, w));
   return std::nullopt;
+}
+
+std::optional<Drop> BenchLayout::check_command(const can::Frame& f) const noexcept {
+  CommandMsg m;
+  return check_command(f, m);
+}
+
+std::optional<Drop> BenchLayout::check_sensors(const can::Frame& f) const noexcept {
+  SensorMsg m;
+  return check_sensors(f, m);
 }
 
 can::Frame BenchLayout::pack_command(const CommandMsg& m) const noexcept {
@@ -81,7 +100,7 @@ can::Frame BenchLayout::pack_command(const CommandMsg& m) const noexcept {
   solenoid_b.put(f, solenoid_b.to_raw(m.solenoid_b_mA));
   restrictor.put(f, restrictor.to_raw(m.restrictor_mA));
   command_counter.put(f, m.counter);
-  command_crc.put(f, e2e_crc(f, command_crc));
+  f.data[checks.command_crc.shift / 8] = e2e_crc(f, checks.command_crc.shift / 8);  // a whole byte (from_dbc)
   return f;
 }
 
@@ -101,7 +120,7 @@ can::Frame BenchLayout::pack_sensors(const SensorMsg& m) const noexcept {
   pilot.put(f, m.pilot_raw);
   supply.put(f, m.supply_raw);
   sensor_counter.put(f, m.counter);
-  sensors_crc.put(f, e2e_crc(f, sensors_crc));
+  f.data[checks.sensors_crc.shift / 8] = e2e_crc(f, checks.sensors_crc.shift / 8);
   return f;
 }
 

@@ -116,13 +116,13 @@ void SlaveNode::step(can::Bus& bus, double now_s) noexcept {
     if (!f) break;
     if (!f->extended && f->id == layout_.command_id) {
       ++cmd_.received;
-      if (const auto why = layout_.check_command(*f)) {
+      CommandMsg c;
+      if (const auto why = layout_.check_command(*f, c)) {
         cmd_.on_drop(*why);
         bad = true;
         ++dropped;
         continue;
       }
-      const CommandMsg c = layout_.unpack_command(*f);
       if (!cmd_.on_counter(c.counter)) {
         bad = true;
         ++dropped;
@@ -256,13 +256,13 @@ bool MasterNode::step(can::Bus& bus, double now_s) noexcept {
     if (!f->extended && f->id == layout_.sensors_id) {
       record(*f, false);
       ++sens_.received;
-      if (const auto why = layout_.check_sensors(*f)) {
+      SensorMsg s;
+      if (const auto why = layout_.check_sensors(*f, s)) {
         sens_.on_drop(*why);
         bad_ = true;
         ++dropped;
         continue;
       }
-      const SensorMsg s = layout_.unpack_sensors(*f);
       if (!sens_.on_counter(s.counter)) {
         bad_ = true;
         ++dropped;

@@ -46,8 +46,8 @@ void EstimatorConfig::validate() const {
   require(!std::isnan(guess_left) && !std::isnan(guess_right), "guess", "guesses must be numbers");
   const bool needs_guesses = model == ModelKind::input_deadzone || model == ModelKind::deadzone_deadband;
   if (needs_guesses) {
-    require(std::isfinite(guess_left) && std::isfinite(guess_right), "guess-left/guess-right",
-            "this model needs both deadzone guesses c_l* and c_r*");
+    // an infinite guess means "not given": lash::estimate_auto searches it (auto.hpp); a bare
+    // estimator never updates that side
     require(guess_left < guess_right, "guess-left",
             "guess-left must be < guess-right (the guesses lie outside the deadzone: c_l* < c_l <= c_r < c_r*)");
   }

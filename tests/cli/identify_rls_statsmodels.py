@@ -36,7 +36,8 @@ with tempfile.TemporaryDirectory() as d:
             f.write(f"{k * dt!r},{v[k]!r},{y_meas[k]!r}\n")
     trace = os.path.join(d, "trace.csv")
     out = subprocess.run([LASH, "estimate", "--model", "input-deadzone", "--guess-left", "-1e9", "--guess-right",
-                          "350", "--lambda", "1", "--p0", "1e6", "--min-updates", "1", data, "--json", "-o", trace],
+                          "350", "--preset", "thesis", "--outlier-gate", "0", "--lambda", "1", "--p0", "1e6", "--min-updates", "1",
+                          data, "--json", "-o", trace],
                          check=True, capture_output=True, text=True).stdout
     j = json.loads(out)
     with open(trace) as f:

@@ -37,7 +37,10 @@ struct Campaign {
   std::uint64_t seed = 1;             ///< base seed; run i uses run_seed(seed, i)
   double random_variance = 10000.0;   ///< randomized input: variance drawn every step (thesis: 10000)
   double random_tau_s = 0.5;          ///< randomized input: low-pass τ (thesis: 0.5 s)
-  EstimatorConfig estimator;          ///< the thesis's settings unless the file says otherwise
+  EstimatorConfig estimator;          ///< lash's settings for the rig's model unless the file says otherwise
+  /// No [estimator] table: each run first records the rig's open-loop response and takes the
+  /// settings that depend on the data (and the switching guesses) from it (lash/identify/auto.hpp).
+  bool estimator_from_data = false;
   std::vector<RunSpec> runs;
 };
 
@@ -50,6 +53,8 @@ std::uint64_t run_seed(std::uint64_t base, std::size_t index) noexcept;
 ///    e ∈ [−500, 500] (the thesis bounds e per side; see docs/sweep.md);
 ///  - coupled_carts: coupled-carts estimator, |acceleration| ≤ 1 m/s², deadband from 7.5 s.
 EstimatorConfig thesis_estimator(rigs::RigKind kind, double dt_s);
+/// lash's settings for a rig (lash::preset_config of the rig's model, Preset::lash).
+EstimatorConfig lash_estimator(rigs::RigKind kind, double dt_s);
 
 /// Reads and validates a campaign file. Every problem (syntax, unknown key, empty matrix,
 /// non-positive duration, bad estimator setting, …) throws InputError naming file, line and key.

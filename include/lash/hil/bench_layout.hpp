@@ -103,9 +103,14 @@ struct BenchLayout : can::ccp::Layout {
   /// nullopt = DLC, CRC and every data signal's DBC range are right; else the first failure.
   std::optional<Drop> check_command(const can::Frame& f) const noexcept;
   std::optional<Drop> check_sensors(const can::Frame& f) const noexcept;
+  /// The same checks, and the decoded message in `out` when they pass (one read of the payload).
+  std::optional<Drop> check_command(const can::Frame& f, CommandMsg& out) const noexcept;
+  std::optional<Drop> check_sensors(const can::Frame& f, SensorMsg& out) const noexcept;
   /// CRC-8 SAE J1850 of a frame: data ID (identifier low byte, high byte), then every
   /// payload byte except the CRC byte `crc` occupies.
   static std::uint8_t e2e_crc(const can::Frame& f, const BitField& crc) noexcept;
+  /// The same with the CRC's byte index.
+  static std::uint8_t e2e_crc(const can::Frame& f, std::size_t crc_byte) noexcept;
   std::uint32_t command_counter_bits() const noexcept { return command_counter.signal().length; }
   std::uint32_t sensor_counter_bits() const noexcept { return sensor_counter.signal().length; }
   /// Plausibility data of the fields (refresh_checks()).

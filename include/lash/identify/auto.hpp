@@ -1,0 +1,101 @@
+#pragma once
+/// @file auto.hpp
+/// Identification that needs no tuning (docs/identification.md, "Defaults chosen from the data"):
+///  - `preset_config(model, preset)`: lash's best settings per model, or the thesis's (§1.5.1);
+///  - `analyse_record` + `tune_to_data`: the settings that depend on the record (noise level,
+///    sample time, excitation) are chosen from it;
+///  - `estimate_auto`: runs the estimator and, for a model that switches on the input
+///    (input-deadzone, deadzone-deadband) without given guesses c_l*, c_r*, finds them by the
+///    fixed-point iteration guess → estimate → guess; given guesses are honoured and checked
+///    against the identified edge (wrong side = `wrong_guess`).
+/// Not real-time safe (allocates, runs whole records). The sample path stays in the estimators.
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "lash/identify/any_estimator.hpp"
+#include "lash/identify/config.hpp"
+
+namespace lash {
+
+enum class Preset : std::uint8_t {
+  lash,   ///< lash's best settings for the model, tuned to the data where they depend on it
+  thesis  ///< the thesis's settings (§1.5.1): RLS, λ = 0.99, P0 = 1000·I, η0 = [1 1 1], no filters
+};
+/// "lash" or "thesis"; throws std::invalid_argument otherwise.
+Preset parse_preset(std::string_view name);
+const char* to_string(Preset p) noexcept;
+
+/// The static settings of `model` for `preset` (before any data is seen), sample period dt_s.
+EstimatorConfig preset_config(ModelKind model, Preset preset = Preset::lash, double dt_s = 0.005);
+
+/// Whether `model` reads a setting (names as in `lash estimate`'s options without the dashes:
+/// "guess-left", "method", "pooled", "accel-limit", …). An unknown name returns true.
+bool model_uses(ModelKind model, std::string_view setting) noexcept;
+
+/// What a record says about the settings that depend on it.
+struct DataTraits {
+  double dt_s = 0.0;          ///< sample period [s]
+  std::size_t samples = 0;
+  double v_lo = 0.0, v_hi = 0.0;  ///< 0.1 % and 99.9 % quantiles of v [v unit]
+  double y_span = 0.0;        ///< 99.9 % − 0.1 % quantile of y [y unit]
+  /// Standard deviation of white measurement noise on y [y unit]: MAD of the second
+  /// differences / (0.6745·√6) (var Δ²e = 6σ² for white e; the signal's own Δ² is small).
+  double noise_sigma = 0.0;
+  /// 90 % quantile of |ẏ| over 40-sample windows, |y(k) − y(k−40)|/(40·T) [y unit/s]: how fast the
+  /// output moves when it moves (the scale of the switching dead band).
+  double ydot_p90 = 0.0;
+  /// 90 % quantile of |ÿ| (second difference / T²) over samples where y moved in the same
+  /// direction three samples in a row [y unit/s²] (coupled carts: the acceleration gate's scale).
+  double yddot_p90 = 0.0;
+  /// Smallest step of y (encoder resolution) [y unit]; 0 when y is not visibly quantised.
+  double quantum = 0.0;
+};
+/// Not real-time safe. Non-finite samples are ignored.
+DataTraits analyse_record(std::span<const double> v, std::span<const double> y, double dt_s);
+
+/// Sets the data-dependent settings of a `Preset::lash` config (docs/identification.md).
+void tune_to_data(EstimatorConfig& cfg, const DataTraits& d);
+
+/// Where a switching guess came from.
+enum class GuessSource : std::uint8_t { unused, given, searched };
+const char* to_string(GuessSource s) noexcept;
+
+/// One side's guess and what the run made of it.
+struct GuessReport {
+  double guess = 0.0;          ///< c* used by the final run [v unit] (±inf: unused)
+  GuessSource source = GuessSource::unused;
+  /// The identified edge lies beyond the guess (c_r > c_r* or c_l < c_l*): the guess sits inside
+  /// the deadzone, the side's regressions mixed samples of two regimes (`reason: wrong_guess`).
+  bool wrong_side = false;
+  double edge = 0.0;           ///< the edge the check used [v unit] (NaN: none)
+};
+
+struct AutoRun {
+  EstimatorConfig cfg;         ///< the settings of the final run (what --print-config writes)
+  EstimationRun run;
+  GuessReport right, left;
+  std::uint64_t outliers = 0;  ///< samples of y the outlier gate replaced (auto_gate.hpp)
+};
+
+/// Runs `cfg`'s estimator over v, y. For input-deadzone and deadzone-deadband, a side whose
+/// guess is infinite is searched: pass 0 uses c* = 0.7·(v quantile of that side); each pass sets
+/// c* = ĉ + max(margin, 0.15·(v_extreme − ĉ)) from the side's identified edge ĉ, or moves c*
+/// halfway out when ĉ lies beyond c* (inside-the-deadzone guess), until c* moves less than 1 %
+/// of the input span (at most 5 passes). Not real-time safe.
+/// y first passes the outlier gate (auto_gate.hpp) with threshold `gate` (0 = off).
+AutoRun estimate_auto(const EstimatorConfig& cfg, std::span<const double> v, std::span<const double> y,
+                      bool keep_trace = false, double gate = 12.0);
+
+/// The switching guesses estimate_auto would use on this record ({c_r*, c_l*}); for the sweep,
+/// which runs its estimator online on a rig whose open-loop record it can take first.
+std::array<double, 2> search_guesses(const EstimatorConfig& cfg, std::span<const double> v,
+                                     std::span<const double> y);
+
+/// The settings as a TOML document that `read_estimator_config` (`lash estimate --config`)
+/// reads back to the same EstimatorConfig (every key written; infinities as ±inf).
+std::string config_to_toml(const EstimatorConfig& cfg);
+
+}  // namespace lash

@@ -1,0 +1,378 @@
+#include "lash/identify/auto.hpp"
+
+#include <algorithm>
+#include <cstdlib>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+#include "lash/identify/auto_gate.hpp"
+
+namespace lash {
+
+namespace {
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kRateShare = 0.10;  // dead band on ẏ as a share of the output's typical rate (docs)
+
+double quantile(std::vector<double> x, double q) {
+  if (x.empty()) return 0.0;
+  const auto k = static_cast<std::size_t>(q * static_cast<double>(x.size() - 1));
+  std::nth_element(x.begin(), x.begin() + static_cast<std::ptrdiff_t>(k), x.end());
+  return x[k];
+}
+
+bool uses_guesses(ModelKind m) noexcept {
+  return m == ModelKind::input_deadzone || m == ModelKind::deadzone_deadband;
+}
+
+/// The deadzone edge a side's regression points at, identified or not (NaN when there is none).
+double raw_edge(const AnyEstimator& est, Side s) {
+  const SideParams p = est.params(s);
+  if (p.identified && std::isfinite(p.c)) return p.c;
+  if (const auto* e = est.get<DeadzoneDeadbandEstimator>()) {
+    if (est.config().pooled) {
+      if (e->updates(s, true) + e->updates(s, false) < est.config().min_updates) return kNaN;
+      const auto& eta = e->pooled_rls(s).eta();
+      return std::fabs(eta[1]) > 1e-12 ? -eta[2] / eta[1] : kNaN;
+    }
+    return kNaN;
+  }
+  if (const auto* e = est.get<InputDeadzoneEstimator>()) {
+    if (e->updates(s) < est.config().min_updates) return kNaN;
+    const auto& eta = e->rls(s).eta();
+    return std::fabs(eta[1]) > 1e-12 ? -eta[2] / eta[1] : kNaN;
+  }
+  return kNaN;
+}
+
+std::string num(double x) {
+  if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
+  std::ostringstream s;
+  s.precision(17);
+  s << x;
+  std::string t = s.str();
+  if (t.find_first_of(".eEn") == std::string::npos) t += ".0";
+  return t;
+}
+}  // namespace
+
+Preset parse_preset(std::string_view name) {
+  if (name == "lash") return Preset::lash;
+  if (name == "thesis") return Preset::thesis;
+  throw std::invalid_argument("unknown preset '" + std::string(name) + "' (expected lash or thesis)");
+}
+
+const char* to_string(Preset p) noexcept { return p == Preset::thesis ? "thesis" : "lash"; }
+
+const char* to_string(GuessSource s) noexcept {
+  switch (s) {
+    case GuessSource::given: return "given";
+    case GuessSource::searched: return "searched";
+    case GuessSource::unused: break;
+  }
+  return "unused";
+}
+
+EstimatorConfig preset_config(ModelKind model, Preset preset, double dt_s) {
+  EstimatorConfig c;  // the thesis's settings (§1.5.1)
+  c.model = model;
+  c.dt_s = dt_s;
+  c.rls.lambda = 0.99;
+  c.rls.p0 = 1000.0;
+  c.rls.eta0 = {1.0, 1.0, 1.0};
+  if (model == ModelKind::coupled_carts) {
+    c.accel_limit = 1.0;  // thesis §1.6.3: |free-cart acceleration| ≤ 1 m/s²
+    c.stage2_start_s = 7.5;
+  }
+  if (preset == Preset::thesis) return c;
+  switch (model) {
+    case ModelKind::deadzone_deadband:
+      // E2's method (docs/identification.md "E2: what got how far"): consistent MA40 on v and y,
+      // switching on a filtered derivative with a dead band, direction held over the filter window,
+      // one pooled 4-parameter regression per side solved by recursive IV, every sample kept.
+      c.pooled = true;
+      c.method = EstimationMethod::iv;
+      c.iv_delay = 45;
+      c.direction_run = 41;
+      c.rls.lambda = 1.0;
+      c.noise.filter_length = 40;
+      c.noise.filter_input = true;
+      c.noise.derivative_filter_length = 20;
+      c.noise.derivative_threshold = 150.0;
+      c.noise.align_delay = 10;
+      break;
+    case ModelKind::input_deadzone:
+      // E4 (lash settings): λ 0.995, a1 ∈ [−1, 0] (stable, non-oscillating first order), b1 ≥ 0.
+      c.rls.lambda = 0.995;
+      c.rls.lower = {-1.0, 0.0, -kInf};
+      c.rls.upper = {0.0, kInf, kInf};
+      break;
+    case ModelKind::output_deadzone:
+      // E3 (lash settings): directional forgetting; λ from the sample time. No moving average: its
+      // start-up ramp would make a constant input look excited (the verdict reads v over the updates).
+      c.rls.lambda = 0.9995;
+      c.rls.forgetting = Forgetting::directional;
+      break;
+    case ModelKind::linear:
+      c.rls.lambda = 0.9995;
+      break;
+    case ModelKind::coupled_carts:
+      c.rls.lambda = 0.995;  // E5 (lash settings)
+      c.stage2_start_s = 5.0;
+      break;
+  }
+  return c;
+}
+
+bool model_uses(ModelKind m, std::string_view s) noexcept {
+  const bool dzdb = m == ModelKind::deadzone_deadband;
+  if (s == "guess-left" || s == "guess-right") return uses_guesses(m);
+  if (s == "pooled" || s == "direction-run") return dzdb;
+  if (s == "method" || s == "iv-delay") return m != ModelKind::coupled_carts;
+  if (s == "accel-limit" || s == "stage2-start") return m == ModelKind::coupled_carts;
+  if (s == "zero-threshold") return m == ModelKind::output_deadzone;
+  if (s == "derivative-threshold" || s == "derivative-filter-length" || s == "derivative-prefilter-length" ||
+      s == "align-delay")
+    return dzdb || m == ModelKind::coupled_carts;
+  return true;
+}
+
+DataTraits analyse_record(std::span<const double> v, std::span<const double> y, double dt_s) {
+  DataTraits d;
+  d.dt_s = dt_s;
+  std::vector<double> vf, yf, d2, steps;
+  vf.reserve(v.size());
+  yf.reserve(y.size());
+  for (std::size_t k = 0; k < v.size() && k < y.size(); ++k)
+    if (std::isfinite(v[k]) && std::isfinite(y[k])) {
+      vf.push_back(v[k]);
+      yf.push_back(y[k]);
+    }
+  d.samples = vf.size();
+  if (vf.size() < 3) return d;
+  d.v_lo = quantile(vf, 0.001);
+  d.v_hi = quantile(vf, 0.999);
+  d.y_span = quantile(yf, 0.999) - quantile(yf, 0.001);
+  d2.reserve(yf.size());
+  for (std::size_t k = 2; k < yf.size(); ++k) d2.push_back(std::fabs(yf[k] - 2.0 * yf[k - 1] + yf[k - 2]));
+  d.noise_sigma = quantile(d2, 0.5) / (0.6745 * std::sqrt(6.0));
+  {
+    std::vector<double> rates;
+    rates.reserve(yf.size());
+    for (std::size_t k = 40; k < yf.size(); ++k) rates.push_back(std::fabs(yf[k] - yf[k - 40]) / (40.0 * dt_s));
+    d.ydot_p90 = quantile(rates, 0.9);
+    std::vector<double> acc;
+    for (std::size_t k = 2; k < yf.size(); ++k) {
+      const double d1 = yf[k] - yf[k - 1], d0 = yf[k - 1] - yf[k - 2];
+      if (d1 * d0 > 0.0) acc.push_back(std::fabs(d1 - d0) / (dt_s * dt_s));
+    }
+    d.yddot_p90 = quantile(acc, 0.9);
+  }
+  // quantised: the nonzero steps are integer multiples of the smallest one
+  for (std::size_t k = 1; k < yf.size(); ++k) {
+    const double s = std::fabs(yf[k] - yf[k - 1]);
+    if (s > 0.0) steps.push_back(s);
+  }
+  if (steps.size() > 10) {
+    const double q = *std::min_element(steps.begin(), steps.end());
+    std::size_t on_grid = 0;
+    for (double s : steps) on_grid += std::fabs(s / q - std::round(s / q)) < 1e-3 ? 1u : 0u;
+    if (q > 0.0 && on_grid >= steps.size() * 99 / 100) d.quantum = q;
+  }
+  return d;
+}
+
+void tune_to_data(EstimatorConfig& c, const DataTraits& d) {
+  c.dt_s = d.dt_s > 0.0 ? d.dt_s : c.dt_s;
+  switch (c.model) {
+    case ModelKind::deadzone_deadband: {
+      // Dead band on ẏ: 3σ of the derivative filter's noise output (||h||₂ of
+      // MA20 ∘ difference/T ∘ MA40 on white noise of the record's σ), and at least one
+      // encoder step per derivative window.
+      const double m = static_cast<double>(c.noise.filter_length);
+      const double m2 = static_cast<double>(c.noise.derivative_filter_length);
+      // h = MA_m2 * (δ − δ₁)/T * MA_m: its taps are (box_m − box_m shifted by 1)/(m·m2·T) summed
+      // m2 times; the difference of two boxes shifted by 1..m2 has 2·min(j, m) nonzero taps.
+      double h2 = 0.0;
+      {
+        // exact ||h||² from the taps, computed on a small buffer
+        const auto L = static_cast<std::size_t>(m + m2 + 1);
+        std::vector<double> box(L, 0.0), h(L, 0.0);
+        for (std::size_t i = 0; i < static_cast<std::size_t>(m); ++i) box[i] = 1.0 / m;
+        for (std::size_t j = 0; j < static_cast<std::size_t>(m2); ++j)
+          for (std::size_t i = 0; i + 1 < L; ++i) {
+            if (i + j < L) h[i + j] += box[i] / (m2 * c.dt_s);
+            if (i + j + 1 < L) h[i + j + 1] -= box[i] / (m2 * c.dt_s);
+          }
+        for (double x : h) h2 += x * x;
+      }
+      const double noise = 3.0 * d.noise_sigma * std::sqrt(h2);
+      const double quant = d.quantum > 0.0 ? d.quantum / (m2 * c.dt_s) : 0.0;
+      c.noise.derivative_threshold = std::max({noise, quant, kRateShare * d.ydot_p90});
+      break;
+    }
+    case ModelKind::output_deadzone:
+    case ModelKind::linear:
+      // a memory of 2 s: several time constants of a mechanical axis and a few reversals (E3 and
+      // EMPS at 1 kHz: λ = 0.9995; 10 s followed closed-loop noise less well on EMPS)
+      c.rls.lambda = std::clamp(1.0 - c.dt_s / 2.0, 0.99, 0.99995);
+      break;
+    case ModelKind::coupled_carts:
+      // a quantised position (linear scale) gives a quantised velocity: average it over 1000 samples
+      if (d.quantum > 0.0) c.rls.lambda = 0.999;
+      // stage 1 leaves out the pin's impacts: accelerations well above the record's usual ones
+      if (d.yddot_p90 > 0.0) c.accel_limit = 3.0 * d.yddot_p90;
+      break;
+    case ModelKind::input_deadzone: {
+      // Projection box from the record's scales (Goodwin & Sin §3.7): a1 ∈ [−1, 0], 0 < b1 ≤ B and
+      // |e| = |b1·c| ≤ B·max|v|, B = 2·span(y)/span(v) (at least twice the largest static gain the
+      // record can show). Without it a side with few samples (amplitude just above the deadzone)
+      // can run away under forgetting (E4: b1 ~ 1e74).
+      const double vspan = d.v_hi - d.v_lo;
+      if (vspan > 0.0 && d.y_span > 0.0) {
+        const double B = 2.0 * d.y_span / vspan;
+        const double E = B * std::max(std::fabs(d.v_lo), std::fabs(d.v_hi));
+        c.rls.lower = {-1.0, 1e-4 * B, -E};
+        c.rls.upper = {0.0, B, E};
+      }
+      break;
+    }
+  }
+}
+
+AutoRun estimate_auto(const EstimatorConfig& cfg0, std::span<const double> v, std::span<const double> y_raw,
+                      bool keep_trace, double gate) {
+  AutoRun out;
+  std::vector<double> yc(y_raw.begin(), y_raw.end());
+  OutlierGateConfig gc;
+  gc.gate = gate;
+  OutlierGate gate_y(gc);
+  // The gate is causal (usable online); over a whole record the sample after a flagged one is also
+  // known: when it lies nearer the flagged value than the last accepted one, the output really
+  // stepped there (a square-wave input) and the sample is restored.
+  std::uint64_t flagged = 0;
+  for (std::size_t k = 0; k < yc.size(); ++k) {
+    const std::uint64_t before = gate_y.rejected();
+    yc[k] = gate_y.step(y_raw[k]);
+    if (gate_y.rejected() == before) continue;
+    const double next = k + 1 < yc.size() ? y_raw[k + 1] : yc[k];
+    if (std::fabs(next - y_raw[k]) < std::fabs(next - yc[k])) yc[k] = y_raw[k];
+    else ++flagged;
+  }
+  out.outliers = flagged;
+  const std::span<const double> y(yc);
+  out.cfg = cfg0;
+  EstimatorConfig& cfg = out.cfg;
+  const bool search_r = uses_guesses(cfg.model) && std::isinf(cfg.guess_right);
+  const bool search_l = uses_guesses(cfg.model) && std::isinf(cfg.guess_left);
+  if (search_r || search_l) {
+    const auto g = search_guesses(cfg, v, y);
+    if (search_r) cfg.guess_right = g[0];
+    if (search_l) cfg.guess_left = g[1];
+  }
+  out.run = run_estimator(cfg, v, y, keep_trace);
+  if (uses_guesses(cfg.model)) {
+    out.right.guess = cfg.guess_right;
+    out.left.guess = cfg.guess_left;
+    out.right.source = search_r ? GuessSource::searched : GuessSource::given;
+    out.left.source = search_l ? GuessSource::searched : GuessSource::given;
+    AnyEstimator est(cfg);
+    for (std::size_t k = 0; k < v.size(); ++k) est.step(v[k], y[k]);
+    out.right.edge = raw_edge(est, Side::right);
+    out.left.edge = raw_edge(est, Side::left);
+    out.right.wrong_side = std::isfinite(out.right.edge) && out.right.edge >= cfg.guess_right;
+    out.left.wrong_side = std::isfinite(out.left.edge) && out.left.edge <= cfg.guess_left;
+  }
+  return out;
+}
+
+std::array<double, 2> search_guesses(const EstimatorConfig& cfg0, std::span<const double> v,
+                                     std::span<const double> y) {
+  if (!uses_guesses(cfg0.model)) return {kInf, -kInf};
+  const DataTraits d = analyse_record(v, y, cfg0.dt_s);
+  const double hi = std::max(d.v_hi, 0.0), lo = std::min(d.v_lo, 0.0);
+  const double span = hi - lo;
+  std::array<double, 2> g{0.7 * hi, 0.7 * lo};
+  if (!(span > 0.0)) return {kInf, -kInf};
+  EstimatorConfig cfg = cfg0;
+  for (int pass = 0; pass < 5; ++pass) {
+    cfg.guess_right = g[0] > 0.0 ? g[0] : kInf;
+    cfg.guess_left = g[1] < 0.0 ? g[1] : -kInf;
+    AnyEstimator est(cfg);
+    for (std::size_t k = 0; k < v.size(); ++k) est.step(v[k], y[k]);
+    std::array<double, 2> next = g;
+    for (int i = 0; i < 2; ++i) {
+      const Side s = i == 0 ? Side::right : Side::left;
+      const double ext = i == 0 ? hi : lo;   // the input's extreme on this side
+      const double c = raw_edge(est, s);
+      const double sg = i == 0 ? 1.0 : -1.0;  // outward
+      if (!std::isfinite(c)) {
+        next[i] = 0.5 * (g[i] + 0.0);       // no data beyond the guess: move it in
+      } else if (sg * (c - g[i]) >= 0.0) {
+        next[i] = 0.5 * (g[i] + ext);       // edge beyond the guess: the guess was inside the deadzone
+      } else {
+        const double cc = sg * c > 0.0 ? c : 0.0;  // an edge across zero means no deadzone there
+        next[i] = cc + 0.15 * (ext - cc);
+      }
+    }
+    const bool moved = std::fabs(next[0] - g[0]) > 0.01 * span || std::fabs(next[1] - g[1]) > 0.01 * span;
+    g = next;
+    if (!moved) break;
+  }
+  return {g[0] > 0.0 ? g[0] : kInf, g[1] < 0.0 ? g[1] : -kInf};
+}
+
+std::string config_to_toml(const EstimatorConfig& c) {
+  std::ostringstream o;
+  const auto tri = [&](const std::array<double, 3>& a) {
+    return "[" + num(a[0]) + ", " + num(a[1]) + ", " + num(a[2]) + "]";
+  };
+  // TOML files hold finite numbers only: a non-finite value (the "none" of a guess, a bound or the
+  // acceleration gate) is the default of every base, so it is written as a comment
+  const auto key = [&](const char* k, double x) {
+    if (!std::isfinite(x)) o << "# ";
+    o << k << " = " << num(x) << "\n";
+  };
+  const auto key3 = [&](const char* k, const std::array<double, 3>& a) {
+    if (!(std::isfinite(a[0]) && std::isfinite(a[1]) && std::isfinite(a[2]))) o << "# ";
+    o << k << " = " << tri(a) << "\n";
+  };
+  o << "# lash estimate settings (docs/identification.md); lash estimate --config FILE reads them back\n";
+  o << "model = \"" << to_string(c.model) << "\"\n";
+  o << "method = \"" << to_string(c.method) << "\"\n";
+  key("guess_left", c.guess_left);
+  key("guess_right", c.guess_right);
+  o << "pooled = " << (c.pooled ? "true" : "false") << "\n";
+  o << "sim_side_by_sign = " << (c.sim_side_by_sign ? "true" : "false") << "\n";
+  o << "iv_delay = " << c.iv_delay << "\n";
+  o << "direction_run = " << c.direction_run << "\n";
+  o << "min_updates = " << c.min_updates << "\n";
+  o << "singular_tol = " << num(c.singular_tol) << "\n";
+  o << "settle_tol = " << num(c.settle_tol) << "\n";
+  o << "settle_updates = " << c.settle_updates << "\n";
+  o << "zero_threshold = " << num(c.zero_threshold) << "\n";
+  key("accel_limit", c.accel_limit);
+  o << "stage2_start = " << num(c.stage2_start_s) << "\n\n";
+  o << "[rls]\n";
+  o << "lambda = " << num(c.rls.lambda) << "\n";
+  o << "p0 = " << num(c.rls.p0) << "\n";
+  o << "eta0 = " << tri(c.rls.eta0) << "\n";
+  key3("lower", c.rls.lower);
+  key3("upper", c.rls.upper);
+  o << "trace_max = " << num(c.rls.trace_max) << "\n";
+  o << "forgetting = \"" << (c.rls.forgetting == Forgetting::directional ? "directional" : "exponential") << "\"\n\n";
+  o << "[noise]\n";
+  o << "filter_length = " << c.noise.filter_length << "\n";
+  o << "filter_input = " << (c.noise.filter_input ? "true" : "false") << "\n";
+  o << "input_delay = " << c.noise.input_delay << "\n";
+  o << "derivative_prefilter_length = " << c.noise.derivative_prefilter_length << "\n";
+  o << "derivative_filter_length = " << c.noise.derivative_filter_length << "\n";
+  o << "derivative_threshold = " << num(c.noise.derivative_threshold) << "\n";
+  o << "align_delay = " << c.noise.align_delay << "\n";
+  return o.str();
+}
+
+}  // namespace lash
