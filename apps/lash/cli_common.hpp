@@ -28,6 +28,9 @@ struct Command {
 Command add_simulate(CLI::App& app);
 Command add_demo(CLI::App& app);
 Command add_closed_loop(CLI::App& app);
+/// lash closed-loop --scenario (cmd_closed_loop_scenario.cpp).
+int run_closed_loop_scenario_cmd(const std::string& path, const std::string& compensation, bool json,
+                                 const std::string& out, const std::string& plot);
 Command add_tune(CLI::App& app);
 Command add_identify_steps(CLI::App& app);
 Command add_estimate(CLI::App& app);

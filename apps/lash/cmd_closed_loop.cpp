@@ -24,6 +24,7 @@ struct Options {
   bool json = false;
   bool online = false;
   std::string out, plot;
+  std::string scenario, compensation = "adaptive";
 };
 
 nlohmann::json metrics_json(const StepMetrics& m) {
@@ -68,6 +69,7 @@ int run_online(const Options& o, const ControllerConfig& thesis, const StepTest&
 }
 
 int run(const Options& o) {
+  if (!o.scenario.empty()) return run_closed_loop_scenario_cmd(o.scenario, o.compensation, o.json, o.out, o.plot);
   const std::string gains_path = o.gains.empty() ? source_dir() + "/config/control/thesis_gains.toml" : o.gains;
   ControllerConfig c = load_controller_config(gains_path);
   PilotValveParams p;
@@ -152,6 +154,9 @@ Command add_closed_loop(CLI::App& app) {
   sub->add_flag("--online", o->online,
                 "Beyond the thesis: compare the gains with a PI + deadzone inverse designed from the online RLS "
                 "estimate, on the virtual pilot-valve rig and on B1 + a second pole");
+  sub->add_option("--scenario", o->scenario,
+                  "Closed-loop scenario TOML with a drifting rig (docs/compensation.md); the step options are ignored");
+  sub->add_option("--compensation", o->compensation, "With --scenario: none | fixed | adaptive (default adaptive)");
   sub->add_option("-o,--output", o->out, "Write both traces as CSV");
   sub->add_option("--plot", o->plot, "Also render a PNG (needs -o)");
   return {sub, [o] { return run(*o); }};

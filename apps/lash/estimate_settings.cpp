@@ -74,9 +74,11 @@ EstimatorConfig assemble(const EstimateOptions& o, ModelKind model, Preset prese
     }
   }
   if (o.forgetting) {
-    if (*o.forgetting == "exponential") cfg.rls.forgetting = Forgetting::exponential;
-    else if (*o.forgetting == "directional") cfg.rls.forgetting = Forgetting::directional;
-    else throw InputError("", 0, "--forgetting", "expected exponential or directional");
+    try {
+      cfg.rls.forgetting = parse_forgetting(*o.forgetting);
+    } catch (const std::invalid_argument& e) {
+      throw InputError("", 0, "--forgetting", e.what());
+    }
   }
   if (!o.columns.empty()) job.columns = split_names(o.columns);
   if (!o.nrmse_window.empty()) {

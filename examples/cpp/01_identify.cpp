@@ -11,7 +11,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "lash/identify/any_estimator.hpp"
+#include "lash/identify/auto.hpp"
 #include "lash/plant/plant_file.hpp"
 #include "lash/plant/simulate.hpp"
 
@@ -30,20 +30,22 @@ int main(int argc, char** argv) try {
   sim.seed = 1;
   const SimulationTrace rec = simulate(plant, sim);
 
-  // 2. The estimator: the library's default settings for the model, the record's sample time.
-  EstimatorConfig cfg;
-  cfg.model = ModelKind::deadzone_deadband;
-  cfg.dt_s = plant.dt_s();
-  cfg.guess_left = -350.0;   // c_l*: switching guesses outside the deadzone [input unit]
-  cfg.guess_right = 350.0;   // c_r*
-  const EstimationRun run = run_estimator(cfg, rec.col("v"), rec.col("y"));
+  // 2. The estimator: lash's settings for the model, the ones that depend on the record
+  //    (noise level, output rate) chosen from it, and no switching guesses — estimate_auto
+  //    finds them by its guess -> estimate -> guess iteration.
+  EstimatorConfig cfg = preset_config(ModelKind::deadzone_deadband, Preset::lash, plant.dt_s());
+  tune_to_data(cfg, analyse_record(rec.col("v"), rec.col("y"), plant.dt_s()));
+  const AutoRun fit = estimate_auto(cfg, rec.col("v"), rec.col("y"));
+  const EstimationRun& run = fit.run;
 
   // 3. What it found, per side (NaN = that side is not identified).
   std::printf("%zu samples, identified: %s\n", rec.samples(), run.report.identified ? "yes" : "no");
   for (const auto& [name, side] : {std::pair{"right", &run.report.right}, std::pair{"left", &run.report.left}}) {
     const SideParams& p = side->params;
-    std::printf("%-5s a1 %9.5f  b1 %9.5f  c %9.3f  d %8.3f\n", name, p.a1, p.b1, p.c, p.d);
+    std::printf("%-5s a1 %9.5f  b1 %9.5f  c %9.3f  d %8.3f  K %7.4f  tau %6.4f s  %s\n", name, p.a1, p.b1, p.c, p.d,
+                side->K, side->tau_s, p.identified ? "identified" : to_string(p.reason));
   }
+  std::printf("truth right a1 -0.96 b1 0.1 c 200 d 30, left a1 -0.94 b1 0.15 c -300 d 50\n");
   return 0;
 } catch (const std::exception& e) {
   std::fprintf(stderr, "01_identify: %s\n", e.what());

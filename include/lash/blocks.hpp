@@ -3,7 +3,9 @@
 /// All discrete-time blocks of SPEC A1. Each is a small value type with a
 /// `noexcept`, allocation-free, O(1) `step()`; configuration is checked in the
 /// constructor (std::invalid_argument).
+#include "lash/blocks/backlash_inverse.hpp"
 #include "lash/blocks/deadband.hpp"
+#include "lash/blocks/deadzone_inverse.hpp"
 #include "lash/blocks/deadzone.hpp"
 #include "lash/blocks/delay.hpp"
 #include "lash/blocks/difference.hpp"

@@ -22,6 +22,30 @@ Deadband::Deadband(PerSide<double> d) : d_(d) {
   require(d.left >= 0 && d.right >= 0, "deadband half-width must be >= 0");
 }
 
+DeadzoneInverseParams DeadzoneInverseParams::from_deadzone(double deadzone, double fraction) {
+  DeadzoneInverseParams p;
+  p.offset_right = p.offset_left = fraction * deadzone;
+  return p;
+}
+
+void DeadzoneInverseParams::validate() const {
+  require(finite(offset_right) && offset_right >= 0, "deadzone inverse offset_right (c_r) must be a finite number >= 0");
+  require(finite(offset_left) && offset_left >= 0, "deadzone inverse offset_left (-c_l) must be a finite number >= 0");
+  require(finite(slope_right) && slope_right > 0, "deadzone inverse slope_right must be a finite number > 0");
+  require(finite(slope_left) && slope_left > 0, "deadzone inverse slope_left must be a finite number > 0");
+  require(finite(smoothing) && smoothing >= 0, "deadzone inverse smoothing must be a finite number >= 0");
+}
+
+DeadzoneInverse::DeadzoneInverse(DeadzoneInverseParams p) : p_(p) { p.validate(); }
+
+void BacklashInverseParams::validate() const {
+  require(finite(right) && right >= 0, "backlash inverse right width must be a finite number >= 0");
+  require(finite(left) && left >= 0, "backlash inverse left width must be a finite number >= 0");
+  require(finite(smoothing) && smoothing >= 0, "backlash inverse smoothing must be a finite number >= 0");
+}
+
+BacklashInverse::BacklashInverse(BacklashInverseParams p) : p_(p), o_(p.right) { p.validate(); }
+
 FirstOrderParams FirstOrderParams::from_continuous(double gain, double tau_s, double dt_s) {
   require(finite(gain), "gain must be finite");
   require(finite(tau_s) && tau_s > 0, "tau must be > 0");

@@ -52,7 +52,7 @@ class SocketCanBus final : public Bus {
   }
 
   bool send(const Frame& f) noexcept override {
-    if (!f.valid() || f.fd) return false;
+    if (!f.valid() || f.fd || f.error) return false;
     can_frame cf{};
     cf.can_id = f.id | (f.extended ? CAN_EFF_FLAG : 0u) | (f.remote ? CAN_RTR_FLAG : 0u);
     cf.len = f.len;

@@ -237,12 +237,7 @@ MessageCodec::MessageCodec(const dbc::Message& message) : message_(message) {
   for (std::size_t i = 0; i < n; ++i) {
     const auto& s = message.signals[i];
     codecs_.emplace_back(s);
-    mux_values_.push_back(s.mux_value);
-    multiplexed_.push_back(s.mux == dbc::MuxRole::multiplexed ? 1 : 0);
-    if (s.mux == dbc::MuxRole::multiplexor && !has_mux_) {
-      has_mux_ = true;
-      mux_index_ = i;
-    }
+    if (s.mux == dbc::MuxRole::multiplexor) has_mux_ = true;
     if (const dbc::Signal* p = message.multiplexor_of(s)) {
       parent_[i] = static_cast<std::int32_t>(p - message.signals.data());
       has_mux_ = true;
@@ -263,28 +258,34 @@ MessageCodec::MessageCodec(const dbc::Message& message) : message_(message) {
       }
   packed_ = message.size <= 8;
   for (std::size_t i = 0; i < codecs_.size() && packed_; ++i) {
-    const auto& s = message.signals[i];
+    const auto& sg = message.signals[i];
     const SignalCodec& c = codecs_[i];
+    if (sg.value_type != dbc::ValueType::integer || (c.length_ == 64 && !c.signed_)) {
+      slow_.push_back(static_cast<std::uint32_t>(i));
+      continue;
+    }
     Lane l{};
     l.mask = c.mask_;
     l.factor = c.factor_;
     l.inv_factor = 1.0 / c.factor_;
     l.offset = c.offset_;
-    l.min_phys = c.min_phys_;
-    l.max_phys = c.max_phys_;
+    l.min_phys = c.has_range_ ? c.min_phys_ : -std::numeric_limits<double>::infinity();
+    l.max_phys = c.has_range_ ? c.max_phys_ : std::numeric_limits<double>::infinity();
     l.raw_lo = c.raw_lo_;
     l.raw_hi_excl = c.raw_hi_excl_;
+    l.raw_min_bits = c.signed_ ? (c.mask_ >> 1) + 1 : 0;  // most negative / 0
+    l.raw_max_bits = c.signed_ ? c.mask_ >> 1 : c.mask_;
+    l.index = static_cast<std::uint32_t>(i);
     l.lo = static_cast<std::uint8_t>(c.lo_base_);  // window at byte 0
     l.sext = static_cast<std::uint8_t>(c.signed_ ? 64 - c.length_ : 0);
-    l.motorola = s.byte_order == dbc::ByteOrder::motorola;
-    l.is_signed = c.signed_;
-    l.has_range = c.has_range_;
-    l.multiplexed = s.mux == dbc::MuxRole::multiplexed;
-    l.integer = s.value_type == dbc::ValueType::integer;
-    l.full64 = c.length_ == 64;
-    l.mux_value = s.mux_value;
+    l.word = sg.byte_order == dbc::ByteOrder::motorola ? 1 : 0;
     lanes_.push_back(l);
   }
+  if (packed_)
+    for (std::size_t i = 0; i < codecs_.size(); ++i) {
+      const SignalCodec& c = codecs_[i];
+      clear_all_[message.signals[i].byte_order == dbc::ByteOrder::motorola ? 1 : 0] |= c.mask_ << c.lo_base_;
+    }
 }
 
 bool MessageCodec::selected(std::size_t i, std::span<const std::uint8_t> data, std::span<const double> values) const noexcept {
@@ -320,16 +321,14 @@ bool MessageCodec::decode(std::span<const std::uint8_t> data, std::span<double> 
   if (values.size() != codecs_.size() || data.size() < message_.size) return false;
   if (packed_) {
     const std::uint64_t le = load_le(data, message_.size);
-    const std::uint64_t words[2] = {le, __builtin_bswap64(le)};  // [motorola]
-    const std::size_t n = lanes_.size();
-    for (std::size_t i = 0; i < n; ++i) {
-      const Lane& l = lanes_[i];
-      const std::uint64_t raw = (words[l.motorola] >> l.lo) & l.mask;
-      if (l.integer && !(l.full64 && !l.is_signed)) {
-        values[i] = static_cast<double>(static_cast<std::int64_t>(raw << l.sext) >> l.sext) * l.factor + l.offset;
-      } else {
-        values[i] = codecs_[i].to_physical(raw);
-      }
+    const std::uint64_t words[2] = {le, __builtin_bswap64(le)};  // [word]
+    for (const Lane& l : lanes_) {
+      const std::uint64_t raw = (words[l.word] >> l.lo) & l.mask;
+      values[l.index] = static_cast<double>(static_cast<std::int64_t>(raw << l.sext) >> l.sext) * l.factor + l.offset;
+    }
+    for (const std::uint32_t i : slow_) {
+      const SignalCodec& c = codecs_[i];
+      values[i] = c.to_physical((words[c.signal_.byte_order == dbc::ByteOrder::motorola ? 1 : 0] >> c.lo_base_) & c.mask_);
     }
   } else {
     for (std::size_t i = 0; i < codecs_.size(); ++i) values[i] = *codecs_[i].decode(data);
@@ -340,76 +339,91 @@ bool MessageCodec::decode(std::span<const std::uint8_t> data, std::span<double> 
   return true;
 }
 
+template <bool Mux>
+std::uint32_t MessageCodec::encode_packed(std::span<const double> values, std::uint64_t set[2], std::uint64_t clear[2]) noexcept {
+  std::uint32_t clamped = 0;
+  for (const Lane& l : lanes_) {
+    if constexpr (Mux) {
+      if (!present_[l.index]) continue;
+      clear[l.word] |= l.mask << l.lo;
+    }
+    const double p = values[l.index];
+    std::uint64_t raw;
+    if (p != p) [[unlikely]] {  // NaN
+      raw = 0;
+      ++clamped;
+    } else {
+      const double pc = std::min(std::max(p, l.min_phys), l.max_phys);  // ±inf without a DBC range
+      std::uint32_t c = pc != p ? 1u : 0u;
+      // Multiply by 1/factor; where that could round differently from the exact quotient
+      // (within ~1e-12 relative of a .5 tie, or beyond 2^51) divide instead, so the result
+      // is always round_half_even((p - offset) / factor).
+      const double q = (pc - l.offset) * l.inv_factor;
+      // Branch-free round half to even for |q| < 2^52: adding and subtracting 2^52 with
+      // q's sign leaves the nearest integer (the FPU rounds ties to even).
+      const double m = std::copysign(4503599627370496.0, q);
+      double r = (q + m) - m;
+      const double aq = std::fabs(q);
+      if (aq >= 2251799813685248.0 || std::fabs(q - r) >= 0.5 - (aq + 1.0) * 1e-12) [[unlikely]]
+        r = round_half_even((pc - l.offset) / l.factor);
+      if (r < l.raw_lo) [[unlikely]] {
+        raw = l.raw_min_bits;
+        c = 1;
+      } else if (r >= l.raw_hi_excl) [[unlikely]] {
+        raw = l.raw_max_bits;
+        c = 1;
+      } else {
+        raw = static_cast<std::uint64_t>(static_cast<std::int64_t>(r)) & l.mask;
+      }
+      clamped += c;
+    }
+    set[l.word] |= raw << l.lo;
+  }
+  for (const std::uint32_t i : slow_) {
+    if (Mux && !present_[i]) continue;
+    const SignalCodec& c = codecs_[i];
+    const std::size_t w = c.signal_.byte_order == dbc::ByteOrder::motorola ? 1 : 0;
+    bool cl = false;
+    const std::uint64_t raw = c.to_raw(values[i], cl);
+    clamped += cl ? 1u : 0u;
+    if (Mux) clear[w] |= c.mask_ << c.lo_base_;
+    set[w] |= raw << c.lo_base_;
+  }
+  return clamped;
+}
+
 MessageCodec::EncodeResult MessageCodec::encode(std::span<const double> values, std::span<std::uint8_t> data) noexcept {
   EncodeResult res;
   if (values.size() != codecs_.size() || data.size() < message_.size) return res;
-  // Which signals the multiplexors' encoded values select (multiplexors first).
-  for (const std::uint32_t i : order_) {
-    const std::int32_t p = parent_[i];
-    bool on = true;
-    if (p >= 0) {
-      const auto pi = static_cast<std::size_t>(p);
-      on = present_[pi] && !std::isnan(values[pi]) && !std::isnan(values[i]);
-      if (on) {
-        bool ignored = false;
-        const std::uint64_t raw = codecs_[pi].to_raw(values[pi], ignored);
-        on = false;
-        for (std::uint32_t r = range_begin_[i]; r < range_begin_[i + 1]; ++r)
-          if (raw >= ranges_[r].lo && raw <= ranges_[r].hi) on = true;
+  if (has_mux_) {
+    // Which signals the multiplexors' encoded values select (multiplexors first).
+    for (const std::uint32_t i : order_) {
+      const std::int32_t p = parent_[i];
+      bool on = true;
+      if (p >= 0) {
+        const auto pi = static_cast<std::size_t>(p);
+        on = present_[pi] && !std::isnan(values[pi]) && !std::isnan(values[i]);
+        if (on) {
+          bool ignored = false;
+          const std::uint64_t raw = codecs_[pi].to_raw(values[pi], ignored);
+          on = false;
+          for (std::uint32_t r = range_begin_[i]; r < range_begin_[i + 1]; ++r)
+            if (raw >= ranges_[r].lo && raw <= ranges_[r].hi) on = true;
+        }
       }
+      present_[i] = on ? 1 : 0;
     }
-    present_[i] = on ? 1 : 0;
   }
   if (packed_) {
     // Bits to clear/set, kept per byte order and merged into one word at the end.
-    std::uint64_t clear[2] = {0, 0}, set[2] = {0, 0};  // [motorola]
-    const std::size_t n = lanes_.size();
-    for (std::size_t i = 0; i < n; ++i) {
-      const Lane& l = lanes_[i];
-      const double p0 = values[i];
-      if (!present_[i]) continue;
-      std::uint64_t raw;
-      bool clamped = false;
-      if (!l.integer) {
-        raw = codecs_[i].to_raw(p0, clamped);
-      } else if (std::isnan(p0)) {
-        raw = 0;
-        clamped = true;
-      } else {
-        double p = p0;
-        if (l.has_range) {
-          if (p < l.min_phys) {
-            p = l.min_phys;
-            clamped = true;
-          } else if (p > l.max_phys) {
-            p = l.max_phys;
-            clamped = true;
-          }
-        }
-        // Multiply by 1/factor; where that could round differently from the exact quotient
-        // (within ~1e-12 relative of a .5 tie, or beyond 2^51) divide instead, so the result
-        // is always round_half_even((p - offset) / factor).
-        const double q = (p - l.offset) * l.inv_factor;
-        double r = round_half_even(q);
-        const double aq = q < 0 ? -q : q;
-        const double d = q - r;
-        if (aq >= 2251799813685248.0 || (d < 0 ? -d : d) >= 0.5 - (aq + 1.0) * 1e-12)
-          r = round_half_even((p - l.offset) / l.factor);
-        if (r < l.raw_lo) {
-          clamped = true;
-          raw = l.is_signed ? (l.mask >> 1) + 1 : 0;  // most negative
-        } else if (r >= l.raw_hi_excl) {
-          clamped = true;
-          raw = l.is_signed ? l.mask >> 1 : l.mask;
-        } else if (l.full64 && !l.is_signed) {
-          raw = static_cast<std::uint64_t>(r);
-        } else {
-          raw = static_cast<std::uint64_t>(static_cast<std::int64_t>(r)) & l.mask;
-        }
-      }
-      res.clamped += clamped ? 1u : 0u;
-      clear[l.motorola] |= l.mask << l.lo;
-      set[l.motorola] |= raw << l.lo;
+    std::uint64_t set[2] = {0, 0};
+    std::uint64_t clear[2] = {0, 0};
+    if (has_mux_) {
+      res.clamped = encode_packed<true>(values, set, clear);
+    } else {
+      res.clamped = encode_packed<false>(values, set, clear);
+      clear[0] = clear_all_[0];
+      clear[1] = clear_all_[1];
     }
     std::uint64_t w = load_le(data, message_.size);
     w = (w & ~(clear[0] | __builtin_bswap64(clear[1]))) | set[0] | __builtin_bswap64(set[1]);
@@ -424,7 +438,7 @@ MessageCodec::EncodeResult MessageCodec::encode(std::span<const double> values, 
     return res;
   }
   for (std::size_t i = 0; i < codecs_.size(); ++i) {
-    if (!present_[i]) continue;
+    if (has_mux_ && !present_[i]) continue;
     if (codecs_[i].encode(values[i], data) == SignalCodec::Status::clamped) ++res.clamped;
   }
   clamp_count_ += res.clamped;

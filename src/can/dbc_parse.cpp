@@ -375,6 +375,11 @@ class Parser {
     bool in_string = false, blank = false;
     for (std::size_t i = 0; i < all.size(); ++i) {
       const char c = all[i];
+      if (!in_string && c == '/' && i + 1 < all.size() && all[i + 1] == '/') {  // a // comment: dropped
+        while (i < all.size() && all[i] != '\n') ++i;
+        blank = true;
+        continue;
+      }
       if (c == '"' && (i == 0 || all[i - 1] != '\\')) in_string = !in_string;
       if (!in_string && (c == ' ' || c == '\t' || c == '\r' || c == '\n')) {
         blank = true;

@@ -196,7 +196,9 @@ void write_asc(std::ostream& os, const std::vector<LogEntry>& entries) {
   os << "date Thu Jan 01 00:00:00.000 am 1970\nbase hex  timestamps absolute\ninternal events logged\n";
   os << "// version 9.0.0\nBegin Triggerblock Thu Jan 01 00:00:00.000 am 1970\n";
   os << fmt::format("{: 9.6f} Start of measurement\n", 0.0);
-  const double t0 = entries.empty() ? 0.0 : entries.front().frame.timestamp_s;
+  // Times from the earliest frame (logs may go backwards), so that none is negative.
+  double t0 = entries.empty() ? 0.0 : entries.front().frame.timestamp_s;
+  for (const auto& e : entries) t0 = std::min(t0, e.frame.timestamp_s);
   for (const auto& e : entries) {
     const Frame& f = e.frame;
     const double t = f.timestamp_s - t0;

@@ -286,7 +286,10 @@ std::vector<LogEntry> parse_blf(std::string_view d, const std::string& file, Log
 }
 
 void write_blf(std::ostream& os, const std::vector<LogEntry>& entries) {
-  const double t0 = entries.empty() ? 0.0 : entries.front().frame.timestamp_s;
+  // The header's start time is the earliest frame's (logs may go backwards), so that no
+  // object time is negative.
+  double t0 = entries.empty() ? 0.0 : entries.front().frame.timestamp_s;
+  for (const auto& e : entries) t0 = std::min(t0, e.frame.timestamp_s);
   const double start = start_of(t0);
   const double stop = entries.empty() ? 0.0 : entries.back().frame.timestamp_s;
   std::string objs;

@@ -47,14 +47,6 @@ Pid::Pid(const PidConfig& config) : cfg_(config) {
           "pid output limits need output_min <= output_max");
 }
 
-DeadzoneInverseParams DeadzoneInverseParams::from_deadzone(double deadzone, double fraction) {
-  return {fraction * deadzone, fraction * deadzone};
-}
-
-DeadzoneInverse::DeadzoneInverse(DeadzoneInverseParams p) : p_(p) {
-  require(nonneg(p.offset_right) && nonneg(p.offset_left), "deadzone inverse offsets must be finite numbers >= 0");
-}
-
 ClosedLoopDiscrete::ClosedLoopDiscrete(const ControllerConfig& config)
     : cfg_(config),
       pid_(config.pid),

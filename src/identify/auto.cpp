@@ -363,7 +363,7 @@ std::string config_to_toml(const EstimatorConfig& c) {
   key3("lower", c.rls.lower);
   key3("upper", c.rls.upper);
   o << "trace_max = " << num(c.rls.trace_max) << "\n";
-  o << "forgetting = \"" << (c.rls.forgetting == Forgetting::directional ? "directional" : "exponential") << "\"\n\n";
+  o << "forgetting = \"" << to_string(c.rls.forgetting) << "\"\n\n";
   o << "[noise]\n";
   o << "filter_length = " << c.noise.filter_length << "\n";
   o << "filter_input = " << (c.noise.filter_input ? "true" : "false") << "\n";

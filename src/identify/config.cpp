@@ -35,6 +35,14 @@ EstimationMethod parse_method(std::string_view n) {
 
 const char* to_string(EstimationMethod m) noexcept { return m == EstimationMethod::iv ? "iv" : "ls"; }
 
+Forgetting parse_forgetting(std::string_view n) {
+  if (n == "exponential") return Forgetting::exponential;
+  if (n == "directional") return Forgetting::directional;
+  throw std::invalid_argument("expected \"exponential\" or \"directional\", got '" + std::string(n) + "'");
+}
+
+const char* to_string(Forgetting f) noexcept { return f == Forgetting::directional ? "directional" : "exponential"; }
+
 namespace {
 void require(bool ok, const char* field, const std::string& msg) {
   if (!ok) throw std::invalid_argument(std::string(field) + ": " + msg);

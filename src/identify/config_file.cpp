@@ -71,9 +71,11 @@ void read_estimator_config(TomlTable& t, EstimatorConfig& c, EstimationJob* job)
     c.rls.upper = triple(*r, "upper", c.rls.upper);
     c.rls.trace_max = r->number_or("trace_max", c.rls.trace_max);
     if (auto f = r->string_opt("forgetting")) {
-      if (*f == "exponential") c.rls.forgetting = Forgetting::exponential;
-      else if (*f == "directional") c.rls.forgetting = Forgetting::directional;
-      else r->fail("forgetting", "expected \"exponential\" or \"directional\"");
+      try {
+        c.rls.forgetting = parse_forgetting(*f);
+      } catch (const std::invalid_argument& e) {
+        r->fail("forgetting", e.what());
+      }
     }
     r->finish();
   }

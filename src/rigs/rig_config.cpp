@@ -83,6 +83,11 @@ void read_carts(TomlTable& t, CoupledCartsParams& p) {
 RigConfig read_rig_config(RigKind kind, TomlTable* table) {
   RigConfig c;
   c.kind = kind;
+  return overlay_rig_config(c, table);
+}
+
+RigConfig overlay_rig_config(RigConfig c, TomlTable* table) {
+  const RigKind kind = c.kind;
   if (table) {
     switch (kind) {
       case RigKind::motor_cart: read_motor(*table, c.motor_cart); break;

@@ -1,12 +1,16 @@
 // In-memory bus and the python-can udp_multicast datagram format.
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <string>
 #include <vector>
 
 #include "lash/can/bus.hpp"
 #include "lash/can/controller_bus.hpp"
 #include "lash/can/datagram.hpp"
+#include "lash/can/log.hpp"
+#include "lash/can/replay.hpp"
 #include "lash/io/error.hpp"
 #include "lash/signals/rng.hpp"
 
@@ -319,4 +323,36 @@ TEST(CanController, PullStopsAtItsReadBudget) {
   EXPECT_EQ(ctl.controller_stats().pulls_cut, 3u);
   EXPECT_EQ(ctl.controller_stats().rx_reads, 10u);
   for (std::uint32_t i = 0; i < 10; ++i) EXPECT_EQ(ctl.receive(0ns)->id, 0x40 + i);
+}
+
+TEST(CanReplay, KeepsErrorRemoteAndFdFlagsOnTheMemBus) {
+  // A candump log with an error frame, a remote frame and CAN FD frames with BRS/ESI:
+  // replayed on a mem bus, another node receives every frame with its flags.
+  const auto entries = lash::can::parse_log(
+      "(1.000000) can0 20000080#0000000000000000\n"
+      "(1.001000) can0 7FF#R3\n"
+      "(1.002000) can0 123##3" + std::string(24, 'A') + "\n"
+      "(1.003000) can0 12345678##2AB\n",
+      "r.log");
+  ASSERT_EQ(entries.size(), 4u);
+  auto tx = open_bus("mem:replay");
+  auto rx = open_bus("mem:replay");
+  std::atomic<bool> stop{false};
+  lash::can::ReplayOptions o;
+  o.speed = 10.0;
+  o.spin_ns = 0;
+  const auto r = lash::can::replay(*tx, entries, o, stop);
+  EXPECT_EQ(r.sent, 4u);
+  EXPECT_FALSE(r.interrupted);
+  for (const auto& e : entries) {
+    const auto f = rx->receive(std::chrono::milliseconds(100));
+    ASSERT_TRUE(f);
+    EXPECT_TRUE(same_content(*f, e.frame));
+  }
+  EXPECT_TRUE(entries[0].frame.error);
+  EXPECT_TRUE(entries[2].frame.brs && entries[2].frame.esi && entries[2].frame.len == 12);
+  EXPECT_TRUE(!entries[3].frame.brs && entries[3].frame.esi);
+  // and a stop request before the start sends nothing
+  stop = true;
+  EXPECT_EQ(lash::can::replay(*tx, entries, o, stop).sent, 0u);
 }

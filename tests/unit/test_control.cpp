@@ -90,16 +90,6 @@ TEST(Pid, RejectsBadConfig) {
   EXPECT_THROW(Pid{c}, std::invalid_argument);
 }
 
-TEST(DeadzoneInverse, ThesisOffsetInDirectionOfCommand) {
-  const auto p = DeadzoneInverseParams::from_deadzone(288.0);
-  EXPECT_DOUBLE_EQ(p.offset_right, 0.97 * 288.0);  // 279.36 mA
-  DeadzoneInverse dzi(p);
-  EXPECT_NEAR(dzi.step(10.0), 289.36, 1e-12);
-  EXPECT_NEAR(dzi.step(-10.0), -289.36, 1e-12);
-  EXPECT_EQ(dzi.step(0.0), 0.0);
-  EXPECT_THROW(DeadzoneInverse({-1.0, 0.0}), std::invalid_argument);
-}
-
 TEST(Controller, ChainPidThenInverseThenSaturation) {
   ControllerConfig c;
   c.pid.gains = {1.5, 0.0, 0.0, 0.0};

@@ -149,21 +149,29 @@ class MessageCodec {
   bool packed() const noexcept { return packed_; }
 
  private:
-  /// Per-signal constants of the one-word path for messages of at most 8 bytes: the
-  /// payload is loaded once as a little-endian and a big-endian 64-bit word and every
-  /// signal is a shift and a mask of one of them.
+  /// Per-signal plan of the one-word path for messages of at most 8 bytes, built at
+  /// construction: the payload is loaded once as a little- and a big-endian 64-bit
+  /// word and every integer signal is a shift and a mask of one of them, scaled with
+  /// the factor and its reciprocal. No per-signal flags are tested on this path: the
+  /// range is ±inf when the DBC gives none, the sign extension shift is 0 for unsigned
+  /// fields; float signals and unsigned 64-bit fields go through `slow_`.
   struct Lane {
     std::uint64_t mask;
     double factor, inv_factor, offset, min_phys, max_phys, raw_lo, raw_hi_excl;
+    std::uint64_t raw_min_bits, raw_max_bits;  ///< what a clamp below/above writes
+    std::uint32_t index;   ///< signal index
     std::uint8_t lo;       ///< LSB position in the word
-    std::uint8_t sext;     ///< 64 - length for signed integers, else 0 (sign extension shift)
-    bool motorola, is_signed, has_range, multiplexed, integer, full64;
-    std::uint64_t mux_value;
+    std::uint8_t sext;     ///< 64 - length for signed fields, else 0
+    std::uint8_t word;     ///< 0 = little-endian (Intel) word, 1 = big-endian (Motorola)
   };
+  template <bool Mux>
+  std::uint32_t encode_packed(std::span<const double> values, std::uint64_t set[2], std::uint64_t clear[2]) noexcept;
+  std::vector<Lane> lanes_;          ///< integer signals of a packed message
+  std::vector<std::uint32_t> slow_;  ///< the other signals of a packed message
+  std::uint64_t clear_all_[2] = {0, 0};  ///< bits of every signal per word (messages without multiplexing)
   /// Multiplexing: signal i is present when its multiplexor parent_[i] is present and
   /// holds a raw value in ranges_[range_begin_[i] .. range_begin_[i + 1]).
   bool selected(std::size_t i, std::span<const std::uint8_t> data, std::span<const double> values) const noexcept;
-  std::vector<Lane> lanes_;
   bool packed_ = false;
   dbc::Message message_;
   std::vector<SignalCodec> codecs_;
@@ -172,9 +180,6 @@ class MessageCodec {
   std::vector<std::uint32_t> range_begin_;
   std::vector<dbc::MuxRange> ranges_;
   std::vector<std::uint8_t> present_;      ///< encode's scratch: signal selected by its multiplexors
-  std::vector<std::uint64_t> mux_values_;  ///< per signal; meaningful when multiplexed
-  std::vector<std::uint8_t> multiplexed_;
-  std::size_t mux_index_ = 0;
   bool has_mux_ = false;
   std::uint64_t clamp_count_ = 0;
 };

@@ -28,6 +28,10 @@ enum class EstimationMethod : std::uint8_t {
 };
 EstimationMethod parse_method(std::string_view name);
 const char* to_string(EstimationMethod m) noexcept;
+/// "exponential" or "directional"; throws std::invalid_argument otherwise (one parser for the
+/// TOML key [rls] forgetting and the --forgetting option).
+Forgetting parse_forgetting(std::string_view name);
+const char* to_string(Forgetting f) noexcept;
 
 /// Settings of every RLS inside an estimator (thesis §1.5.1: λ = 0.99, P0 = 1000·I, η0 = [1 1 1]).
 /// Parameter order is [a1, b1, e] (SPEC A4); the linear model uses the first two.

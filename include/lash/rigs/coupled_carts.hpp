@@ -54,6 +54,15 @@ class CoupledCarts {
   CoupledCartsSample step(double volts) noexcept;
   CoupledCartsSample initial_output() const noexcept { return {0.0, 0.0}; }
 
+  /// Replaces the free cart's and the slot's parameters mid-run (a drifting plant, e.g. a
+  /// clearance that grows). `p` must be valid; the motor cart and the free encoder keep theirs.
+  void set_params(const CoupledCartsParams& p) noexcept {
+    const MotorCartParams m = p_.motor;
+    const double enc = p_.free_encoder_step_m;
+    p_ = p;
+    p_.motor = m;
+    p_.free_encoder_step_m = enc;
+  }
   double motor_velocity_m_s() const noexcept { return drive_.velocity_m_s(); }
   double motor_position_m() const noexcept { return drive_.position_m(); }
   double free_velocity_m_s() const noexcept { return v2_; }

@@ -75,6 +75,16 @@ class PilotValveRig {
     }
     return measure() - bias_estimate_;
   }
+  /// Replaces the physics mid-run (a drifting plant, e.g. the deadzone growing). `p` must be
+  /// valid (validate() beforehand); substeps and bias_window_s keep their values. noexcept, O(1).
+  void set_params(const PilotValveRigParams& p) noexcept {
+    const int n = p_.substeps;
+    const double w = p_.bias_window_s;
+    p_ = p;
+    p_.substeps = n;
+    p_.bias_window_s = w;
+    sol_alpha_ = -std::expm1(-h_ / p_.solenoid_tau_s);
+  }
   /// Measurement before the first step, bias removed [kPa].
   double initial_output() noexcept { return measure() - bias_estimate_; }
 

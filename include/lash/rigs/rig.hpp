@@ -30,5 +30,7 @@ struct RigConfig {
 /// Applies the overrides in `table` (a campaign's `[rig_params]`) to the defaults of `kind`.
 /// Unknown keys and invalid values throw InputError naming file, line and key.
 RigConfig read_rig_config(RigKind kind, TomlTable* table);
+/// The same, applied on top of `base` (keys absent keep base's values; a drifting rig).
+RigConfig overlay_rig_config(RigConfig base, TomlTable* table);
 
 }  // namespace lash::rigs

@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# lash closed-loop --scenario: a bad scenario -> exit 2, a message naming file, line and key, no trace left behind.
+set -uo pipefail
+d=$(mktemp -d); trap 'rm -rf "$d"' EXIT
+fail=0
+head=$'rig = "pilot_valve"\ndt_s = 0.005\nduration_s = 2\n'
+tail=$'[reference]\nkind = "sine"\namplitude = 100\nfrequency = 3\n[controller]\nkp = 0.5\nki = 10\n'
+win=$'score_window_s = [1, 2]\n'
+check() {  # name expected-regex content
+  local name=$1 want=$2 content=$3
+  printf '%s' "$content" > "$d/$name.toml"
+  local out rc
+  out=$("$LASH" closed-loop --scenario "$d/$name.toml" --compensation adaptive -o "$d/$name.csv" 2>&1); rc=$?
+  if [[ $rc -ne 2 ]]; then echo "FAIL $name: exit $rc (want 2): $out"; fail=1; return; fi
+  if ! grep -Eq -- "$want" <<<"$out"; then echo "FAIL $name: message '$out' lacks /$want/"; fail=1; return; fi
+  if ls "$d" | grep -q "^$name.csv"; then echo "FAIL $name: output file left behind"; fail=1; return; fi
+  echo "ok   $name: $out"
+}
+check unknown_rig_param "unknown_rig_param.toml:6: 'rig_params.deadzone_mA'.*unknown key" "${head}${win}"$'[rig_params]\ndeadzone_mA = 300\n'"$tail"
+check drift_unknown     "drift_unknown.toml:7: 'drift\[0\].param'.*deadzone_center_mA"   "${head}${win}"$'[[drift]]\nat_s = 1\nparam = "deadzone_center_mA"\nvalue = 3\n'"$tail"
+check drift_late        "drift_late.toml:6: 'drift\[0\].at_s'.*inside the run"            "${head}${win}"$'[[drift]]\nat_s = 5\nparam = "deadzone_right_mA"\nvalue = 380\n'"$tail"
+check drift_negative    "drift_negative.toml:6: 'drift\[0\].at_s'.*inside the run"        "${head}${win}"$'[[drift]]\nat_s = -1\nparam = "deadzone_right_mA"\nvalue = 380\n'"$tail"
+check drift_bad_value   "drift_bad_value.toml:7: 'drift\[0\].param'.*deadzone"           "${head}${win}"$'[[drift]]\nat_s = 1\nparam = "deadzone_right_mA"\nvalue = -50\n'"$tail"
+check window_outside    "window_outside.toml:4: 'score_window_s'.*duration_s"           "${head}"$'score_window_s = [1, 3]\n'"$tail"
+check window_reversed   "window_reversed.toml:4: 'score_window_s'"                      "${head}"$'score_window_s = [1.5, 1]\n'"$tail"
+check nominal_sign      "nominal_sign.toml:[0-9]+: 'compensation.deadzone_left'.*<= 0"   "${head}${win}${tail}"$'[compensation]\ndeadzone_right = 288\ndeadzone_left = 296\n'
+check nominal_sign_r    "nominal_sign_r.toml:[0-9]+: 'compensation.deadzone_right'.*>= 0" "${head}${win}${tail}"$'[compensation]\ndeadzone_right = -288\n'
+check carts_sign        "carts_sign.toml:[0-9]+: 'compensation.deadband_left'.*>= 0" $'rig = "coupled_carts"\ndt_s = 0.001\nduration_s = 2\n'"${win}${tail}"$'[compensation]\ndeadband_left = -0.005\n'
+check wrong_rig_key     "wrong_rig_key.toml:[0-9]+: 'compensation.deadband_right'"         "${head}${win}${tail}"$'[compensation]\ndeadband_right = 0.005\n'
+out=$("$LASH" closed-loop --scenario "$d/nope.toml" 2>&1); rc=$?
+[[ $rc -eq 2 && $out == *"nope.toml"* ]] || { echo "FAIL missing file: $rc $out"; fail=1; }
+printf '%s' "${head}${win}${tail}" > "$d/ok.toml"
+out=$("$LASH" closed-loop --scenario "$d/ok.toml" --compensation sometimes 2>&1); rc=$?
+[[ $rc -eq 2 && $out == *"compensation"* ]] || { echo "FAIL bad mode: $rc $out"; fail=1; }
+exit $fail
