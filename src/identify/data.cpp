@@ -1,5 +1,6 @@
 #include "lash/identify/data.hpp"
 
+#include "lash/identify/estimate.hpp"
 #include "lash/io/csv.hpp"
 #include "lash/io/error.hpp"
 #include "lash/io/mat.hpp"
