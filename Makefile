@@ -30,6 +30,7 @@ build-clang: deps
 demo: build
 	$(BUILD)/bin/lash demo --out-dir $(BUILD)/demo
 	$(BUILD)/bin/lash hil run --duration 5 --out-dir $(BUILD)/demo/hil || $(BUILD)/bin/lash hil run --duration 5 --no-isolate --out-dir $(BUILD)/demo/hil
+	gnuplot -e "dir='$(BUILD)/demo/hil'" scripts/plot_hil_run.gp && echo "plot of the HIL run: $(BUILD)/demo/hil/hil_run.png"
 
 test: build build-clang
 	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)

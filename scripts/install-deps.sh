@@ -16,6 +16,8 @@ packages=(
   # python oracles (Debian's /usr/bin/python3)
   python3 python3-numpy python3-scipy python3-statsmodels python3-can
   python3-canmatrix python3-msgpack python3-crcmod
+  # the lash Python package, its examples and the fleet example on Dask
+  pybind11-dev python3-dev python3-distributed python3-matplotlib python3-pytest
   # SocketCAN test under qemu
   qemu-system-x86 busybox-static cpio
   # libFuzzer / sanitizers runtime for clang

@@ -147,14 +147,20 @@ std::string summary_json(const Campaign& c, const Summary& s, const std::vector<
 }
 
 void write_results_csv(const std::string& path, const Campaign& c, const std::vector<RunResult>& results) {
-  (void)c;
   AtomicFile f(path);
+  f.stream() << results_csv_text(c, results);
+  f.commit();
+}
+
+std::string results_csv_text(const Campaign& c, const std::vector<RunResult>& results) {
+  (void)c;
+  std::string text;
   std::string line =
       "run,waveform,amplitude,frequency_rad_s,repeat,seed,nrmse,max_abs_y,"
       "a1_r,b1_r,c_r,K_r,tau_r_s,identified_r,updates_r,rejected_r,"
       "a1_l,b1_l,c_l,K_l,tau_l_s,identified_l,updates_l,rejected_l,"
       "d,identified_d,param_error,true_K_r,true_tau_r_s,true_c_r,true_K_l,true_tau_l_s,true_c_l,true_d\n";
-  f.stream() << line;
+  text += line;
   auto put = [&](double x) {
     line += ',';
     append_double(line, x);
@@ -190,9 +196,9 @@ void write_results_csv(const std::string& path, const Campaign& c, const std::ve
     }
     put(r.truth.d);
     line += '\n';
-    f.stream() << line;
+    text += line;
   }
-  f.commit();
+  return text;
 }
 
 }  // namespace lash::sweep

@@ -1,5 +1,6 @@
 #include "lash/identify/data.hpp"
 
+#include "lash/identify/estimate.hpp"
 #include "lash/io/csv.hpp"
 #include "lash/io/error.hpp"
 #include "lash/io/mat.hpp"
@@ -28,18 +29,7 @@ Record load_record(const std::filesystem::path& path, const std::vector<std::str
   if (names.size() != 3) throw InputError("", 0, "--columns", "expected three column names: t,v,y");
   Record r;
   r.data = load_columns(path, names);
-  const auto& t = r.data.cols.at(0);
-  if (t.empty()) throw InputError(r.data.file, 0, names[0], "no data rows");
-  if (t.size() < 3) throw InputError(r.data.file, 0, names[0], "need at least 3 samples");
-  for (std::size_t i = 1; i < t.size(); ++i) {
-    if (!(t[i] > t[i - 1])) {
-      const int line = r.data.line_of_row.empty() ? 0 : r.data.line_of_row[i];
-      throw InputError(r.data.file, line, names[0],
-                       "time must increase strictly (row " + std::to_string(i + 1) + ": " + format_double(t[i]) +
-                           " after " + format_double(t[i - 1]) + ")");
-    }
-  }
-  r.dt_s = (t.back() - t.front()) / static_cast<double>(t.size() - 1);
+  r.dt_s = sample_period(r.data.cols.at(0), r.data.file, r.data.line_of_row, names[0]);
   return r;
 }
 

@@ -27,12 +27,20 @@ std::uint64_t noise_seed(std::uint64_t seed) noexcept { return seed ^ 0x6c617368
 SimulationTrace simulate(Plant& plant, const SimulationSpec& spec) {
   if (!(std::isfinite(spec.noise_variance) && spec.noise_variance >= 0))
     throw std::invalid_argument("noise variance must be >= 0");
-  const double dt = plant.dt_s();
-  const std::size_t n = sample_count(spec.duration_s, dt);
+  const std::size_t n = sample_count(spec.duration_s, plant.dt_s());
   SignalSpec in = spec.input;
   in.seed = spec.seed;
-  Signal sig(in, dt);
-  GaussianNoise noise(spec.noise_variance, noise_seed(spec.seed));
+  Signal sig(in, plant.dt_s());
+  std::vector<double> v(n);
+  for (auto& x : v) x = sig.next();
+  return simulate(plant, v, spec.noise_variance, spec.seed);
+}
+
+SimulationTrace simulate(Plant& plant, std::span<const double> v, double noise_variance, std::uint64_t seed) {
+  if (!(std::isfinite(noise_variance) && noise_variance >= 0)) throw std::invalid_argument("noise variance must be >= 0");
+  const double dt = plant.dt_s();
+  const std::size_t n = v.size();
+  GaussianNoise noise(noise_variance, noise_seed(seed));
   plant.reset();
 
   SimulationTrace tr;
@@ -41,10 +49,9 @@ SimulationTrace simulate(Plant& plant, const SimulationSpec& spec) {
     tr.names.push_back("x" + std::to_string(i + 1) + "_" + block_kind(plant.blocks()[i]));
   tr.cols.assign(tr.names.size(), std::vector<double>(n));
   for (std::size_t k = 0; k < n; ++k) {
-    const double v = sig.next();
-    const double y = plant.step(v);
+    const double y = plant.step(v[k]);
     tr.cols[0][k] = static_cast<double>(k) * dt;
-    tr.cols[1][k] = v;
+    tr.cols[1][k] = v[k];
     tr.cols[2][k] = y + noise.step();
     tr.cols[3][k] = y;
     const auto s = plant.signals();

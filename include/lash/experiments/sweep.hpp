@@ -107,5 +107,7 @@ std::string summary_json(const Campaign& c, const Summary& s, const std::vector<
 /// nrmse, per side a1/b1/c/K/tau/identified/updates, d, d_identified, param_error and the
 /// rig's true K/tau/c per side. Not-identified values are written as "nan".
 void write_results_csv(const std::string& path, const Campaign& c, const std::vector<RunResult>& results);
+/// The text write_results_csv() writes (header line and one line per run).
+std::string results_csv_text(const Campaign& c, const std::vector<RunResult>& results);
 
 }  // namespace lash::sweep

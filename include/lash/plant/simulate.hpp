@@ -3,6 +3,7 @@
 /// Open-loop simulation of a plant driven by a signal, with optional additive
 /// Gaussian measurement noise on y. Not real-time safe (allocates the trace).
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -35,5 +36,11 @@ std::uint64_t noise_seed(std::uint64_t seed) noexcept;
 
 /// Runs the plant from its zero state (the plant is reset first).
 SimulationTrace simulate(Plant& plant, const SimulationSpec& spec);
+
+/// Runs the plant from its zero state over a given input v (one sample per step, t_k = k·T),
+/// adding Gaussian noise of `noise_variance` [y unit²] to y from noise_seed(seed).
+/// The trace has the columns of simulate(plant, spec); the same v gives the same bits.
+SimulationTrace simulate(Plant& plant, std::span<const double> v, double noise_variance = 0.0,
+                         std::uint64_t seed = 1);
 
 }  // namespace lash

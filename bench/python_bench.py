@@ -1,0 +1,125 @@
+#!/usr/bin/env python3
+"""Speed of the lash Python package, as ratios printed in one run (docs/python.md):
+
+1. lash.estimate on 10^6 samples from numpy arrays, per sample, against the C++ Google
+   Benchmark of the same estimator on the same plant data (BM_DeadzoneDeadband of lash_bench);
+   goal: ratio <= 1.2. Timed with intervals=False (the estimator pass the benchmark times); the
+   default intervals=True runs the estimator once more over sections and is printed too.
+2. The per-call overhead of Estimator.update (one Python call per sample) over update_many.
+3. The fleet example (examples/python/05_fleet.py) on a LocalCluster of 2 workers against 1
+   worker (cluster start-up not timed); goal: speed-up >= 1.7 on 2 cores.
+
+    PYTHONPATH=build/python /usr/bin/python3 bench/python_bench.py [--lash-bench build/bin/lash_bench]
+"""
+import argparse
+import importlib.util
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+import lash
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SRC = os.path.dirname(HERE)
+
+
+def best_of(fn, repeat):
+    best = float("inf")
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def e1_data(n):
+    """The data of bench_identify.cpp: the E1 plant driven by v = 600 sin(0.005 k)."""
+    plant = lash.Plant(dt_s=0.005, blocks=[
+        {"kind": "deadzone", "left": -300.0, "right": 200.0},
+        {"kind": "linear", "right": {"a1": -0.96, "b1": 0.1}, "left": {"a1": -0.94, "b1": 0.15}},
+        {"kind": "deadband", "half_width": {"left": 50.0, "right": 30.0}},
+    ])
+    v = 600.0 * np.sin(0.005 * np.arange(n))
+    tr = plant.simulate(v)
+    return tr["t"], tr["v"], tr["y"]
+
+
+def cpp_ns_per_sample(lash_bench, name):
+    out = subprocess.run([lash_bench, "--benchmark_filter=^%s$" % name, "--benchmark_format=json",
+                          "--benchmark_repetitions=5", "--benchmark_report_aggregates_only=true"],
+                         capture_output=True, text=True, check=True)
+    for b in json.loads(out.stdout)["benchmarks"]:
+        if b.get("aggregate_name") == "median":
+            return b["real_time"] * {"ns": 1.0, "us": 1e3, "ms": 1e6}[b["time_unit"]]
+    raise RuntimeError("no median in lash_bench output")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--lash-bench", default=os.path.join(SRC, "build", "bin", "lash_bench"))
+    ap.add_argument("--fleet-records", type=int, default=40)
+    ap.add_argument("--fleet-duration", type=float, default=200.0, help="record length [s]")
+    ap.add_argument("--no-fleet", action="store_true", help="skip the fleet speed-up")
+    args = ap.parse_args()
+
+    n = 10 ** 6
+    t, v, y = e1_data(n)
+    settings = dict(guess_left=-350.0, guess_right=350.0)
+    # the benchmark's estimator: thesis settings, given guesses, no outlier gate, no intervals
+    same = dict(preset="thesis", outlier_gate=0, intervals=False, **settings)
+    lash.estimate(t, v, y, **same)
+    py_s = best_of(lambda: lash.estimate(t, v, y, **same), 7)
+    py_ns = py_s / n * 1e9
+    full_ns = best_of(lambda: lash.estimate(t, v, y, **settings), 3) / n * 1e9
+    print("1. lash.estimate, deadzone-deadband, 10^6 samples from numpy: %.2f ns/sample (%.1f M samples/s) with the"
+          " benchmark's settings; %.2f ns/sample with the defaults (preset lash, outlier gate, 95 %% intervals)"
+          % (py_ns, 1e3 / py_ns, full_ns))
+    if os.path.exists(args.lash_bench):
+        cpp = cpp_ns_per_sample(args.lash_bench, "BM_DeadzoneDeadband")
+        print("   C++ benchmark BM_DeadzoneDeadband: %.2f ns/sample -> ratio Python/C++ = %.3f (goal <= 1.2)"
+              % (cpp, py_ns / cpp))
+    else:
+        print("   (no %s: build the lash_bench target for the C++ ratio)" % args.lash_bench)
+
+    m = 200000
+    e = lash.Estimator("deadzone-deadband", 0.005, **settings)
+    many_s = best_of(lambda: (e.reset(), e.update_many(v[:m], y[:m])), 5) / m
+    upd = e.update
+    vl, yl = v[:m].tolist(), y[:m].tolist()
+
+    def one_by_one():
+        e.reset()
+        for a, b in zip(vl, yl):
+            upd(a, b)
+    one_s = best_of(one_by_one, 3) / m
+    print("2. Estimator.update: %.0f ns per call vs %.1f ns per sample in update_many -> overhead %.0f ns per call"
+          % (one_s * 1e9, many_s * 1e9, (one_s - many_s) * 1e9))
+
+    if args.no_fleet:
+        return 0
+    spec = importlib.util.spec_from_file_location("fleet", os.path.join(SRC, "examples", "python", "05_fleet.py"))
+    fleet = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(fleet)
+    from dask.distributed import Client, LocalCluster
+
+    with tempfile.TemporaryDirectory() as d:
+        fleet.generate(d, args.fleet_records, duration_s=args.fleet_duration)
+        files = fleet.records(d)
+        times = {}
+        for workers in (1, 2):
+            with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None) as c, \
+                    Client(c) as client:
+                fleet.identify_on(client, files[:workers])  # warm-up: import lash on every worker
+                times[workers] = best_of(lambda: fleet.identify_on(client, files), 3)
+        print("3. fleet of %d records x %g s: 1 worker %.2f s, 2 workers %.2f s -> speed-up %.2f (goal >= 1.7)"
+              % (len(files), args.fleet_duration, times[1], times[2], times[1] / times[2]))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

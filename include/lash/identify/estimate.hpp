@@ -1,0 +1,46 @@
+#pragma once
+/// @file estimate.hpp
+/// One estimation over a whole record, as `lash estimate` and Python's `lash.estimate` do it:
+/// the sample period from t, the settings for the record and the NRMSE score; the JSON object is
+/// estimate_json() of estimate_report.hpp. One implementation, so the CLI's `--json` and
+/// Python's `Result.to_dict()` cannot drift apart.
+/// Not real-time safe (allocates). Errors are lash::InputError naming file, line and column.
+#include <span>
+#include <string>
+#include <vector>
+
+#include "lash/identify/any_estimator.hpp"
+#include "lash/identify/config_file.hpp"
+#include "lash/identify/estimate_report.hpp"
+
+namespace lash {
+
+/// What `lash estimate` reports about one record.
+struct EstimateResult {
+  EstimateReport report;
+  double dt_s = 0.0;        ///< sample period used by the estimator (mean step of t) [s]
+  double nrmse = 0.0;       ///< NRMSE of the free-run simulation over the window (SPEC A6); NaN if empty
+  double nrmse_t0_s = 0.0;  ///< window start [s]
+  double nrmse_t1_s = 0.0;  ///< window end [s] (the last t when the job leaves it open)
+};
+
+/// Checks a time column (at least 3 samples, strictly increasing) and returns its mean step [s].
+/// Errors name `file`, the line of the row (from `line_of_row`, when given) and the column `t_name`.
+double sample_period(std::span<const double> t, const std::string& file = "", const std::vector<int>& line_of_row = {},
+                     const std::string& t_name = "t");
+
+/// The estimator settings for one record: `cfg` with the record's sample period `dt_s` [s] and
+/// the verdict's fit window starting where the job's reported NRMSE window does.
+EstimatorConfig config_for_record(EstimatorConfig cfg, const EstimationJob& job, double dt_s);
+
+/// Scores a finished run: the NRMSE window of `job` over t, y and the simulated output.
+EstimateResult score_estimate(const EstimateReport& report, double dt_s, const EstimationJob& job,
+                              std::span<const double> t, std::span<const double> y, std::span<const double> ysim);
+
+/// The fit part of the report (estimate_json / estimate_text).
+ReportFit report_fit(const EstimateResult& result) noexcept;
+
+/// The JSON object printed by `lash estimate --json`: estimate_json(report, report_fit(result)).
+std::string to_json(const EstimateResult& result);
+
+}  // namespace lash

@@ -1,0 +1,299 @@
+// lash.estimate, lash.Estimator, lash.Result, lash.read_record: conversion only; the work is
+// lash::run_estimator / add_intervals / score_estimate / to_json (= estimate_json), the calls
+// `lash estimate` makes.
+#include <cmath>
+#include <memory>
+#include <optional>
+
+#include "convert.hpp"
+#include "lash/identify/any_estimator.hpp"
+#include "lash/identify/auto.hpp"
+#include "lash/identify/config_file.hpp"
+#include "lash/identify/data.hpp"
+#include "lash/identify/estimate.hpp"
+#include "lash/io/error.hpp"
+
+namespace lash::py {
+
+namespace {
+
+Preset preset_of(const std::string& name) {
+  try {
+    return parse_preset(name);
+  } catch (const std::invalid_argument& e) {
+    throw InputError("", 0, "preset", e.what());
+  }
+}
+
+ModelKind model_of(const std::string& name) {
+  try {
+    return parse_model_kind(name);
+  } catch (const std::invalid_argument& e) {
+    throw InputError("", 0, "model", e.what());
+  }
+}
+
+/// As `lash estimate` assembles them: the preset's settings, those chosen from the record (preset
+/// lash, when v and y are given), then the keys of an estimator config file (docs/identification.md).
+EstimatorConfig configure(EstimationJob& job, const std::string& model, const std::string& preset, double dt_s,
+                          const pyb::dict& settings, std::span<const double> v = {}, std::span<const double> y = {}) {
+  const ModelKind m = model_of(model);
+  const Preset p = preset_of(preset);
+  EstimatorConfig cfg = preset_config(m, p);
+  cfg.dt_s = dt_s;
+  if (p == Preset::lash && !v.empty()) tune_to_data(cfg, analyse_record(v, y, dt_s));
+  const toml::table tbl = to_toml(settings);
+  TomlTable t(tbl, "");
+  read_estimator_config(t, cfg, &job);
+  cfg.model = m;
+  return cfg;
+}
+
+void validate(EstimatorConfig& cfg, const EstimationJob& job, double dt_s) {
+  cfg = config_for_record(cfg, job, dt_s);
+  try {
+    cfg.validate();
+  } catch (const std::invalid_argument& e) {
+    throw InputError("", 0, "", e.what());
+  }
+}
+
+pyb::object num(double x) { return std::isfinite(x) ? pyb::object(pyb::float_(x)) : pyb::object(pyb::none()); }
+
+struct Result {
+  EstimateResult res;
+  std::string json;
+  pyb::object yhat = pyb::none(), ysim = pyb::none(), params = pyb::none();
+  // what lash.estimate adds as `lash estimate --json` does (estimate_auto's report)
+  std::optional<AutoRun> autorun;
+  std::string preset;
+
+  explicit Result(EstimateResult r) : res(std::move(r)), json(to_json(res)) {}
+  pyb::dict to_dict() const {
+    pyb::dict d = pyb::module_::import("json").attr("loads")(json);
+    if (!autorun) return d;
+    auto put_guess = [&](const char* side, const GuessReport& g) {
+      if (!d.contains(side) || g.source == GuessSource::unused) return;
+      pyb::dict s = d[side];
+      if (g.wrong_side) s["reason"] = "wrong_guess";
+      pyb::dict gd;
+      gd["value"] = num(g.guess);
+      gd["source"] = to_string(g.source);
+      gd["edge_seen"] = num(g.edge);
+      s["guess"] = gd;
+    };
+    put_guess("right", autorun->right);
+    put_guess("left", autorun->left);
+    d["outliers"] = autorun->outliers;
+    d["preset"] = preset;
+    return d;
+  }
+};
+
+class Estimator {
+ public:
+  Estimator(const std::string& model, double dt_s, const std::string& preset, const pyb::kwargs& settings) {
+    if (!(dt_s > 0) || !std::isfinite(dt_s)) throw InputError("", 0, "dt", "must be a finite number > 0 [s]");
+    cfg_ = configure(job_, model, preset, dt_s, settings);
+    validate(cfg_, job_, dt_s);
+    est_ = std::make_unique<AnyEstimator>(cfg_);
+  }
+
+  double update(double v, double y, std::optional<double> t_s) {
+    step(v, y, t_s ? *t_s : next_t());
+    return yhat_;
+  }
+
+  pyb::array_t<double> update_many(const pyb::handle& v_obj, const pyb::handle& y_obj, const pyb::handle& t_obj) {
+    const DoubleArray va = as_doubles(v_obj, "v"), ya = as_doubles(y_obj, "y");
+    const auto v = span_of(va), y = span_of(ya);
+    if (v.size() != y.size())
+      throw InputError("", 0, "y", "has " + std::to_string(y.size()) + " samples, v has " + std::to_string(v.size()));
+    DoubleArray ta;
+    std::span<const double> t;
+    if (!t_obj.is_none()) {
+      ta = as_doubles(t_obj, "t");
+      t = span_of(ta);
+      if (t.size() != v.size())
+        throw InputError("", 0, "t", "has " + std::to_string(t.size()) + " samples, v has " + std::to_string(v.size()));
+    }
+    std::vector<double> yhat(v.size());
+    {
+      pyb::gil_scoped_release nogil;
+      reserve(v.size());
+      for (std::size_t k = 0; k < v.size(); ++k) {
+        step(v[k], y[k], t.empty() ? next_t() : t[k]);
+        yhat[k] = yhat_;
+      }
+    }
+    return to_numpy(std::move(yhat));
+  }
+
+  Result result(bool intervals) const {
+    EstimationRun run;
+    run.report = est_->report();
+    if (intervals) add_intervals(run, cfg_, v_, y_);
+    return Result(score_estimate(run.report, cfg_.dt_s, job_, t_, y_, ysim_));
+  }
+
+  void reset() {
+    est_ = std::make_unique<AnyEstimator>(cfg_);
+    t_.clear();
+    v_.clear();
+    y_.clear();
+    ysim_.clear();
+  }
+
+  std::uint64_t samples() const noexcept { return t_.size(); }
+  double dt_s() const noexcept { return cfg_.dt_s; }
+  pyb::dict params() const {
+    pyb::dict d;
+    const auto names = est_->param_names();
+    std::vector<double> values(names.size());
+    est_->param_values(values);
+    for (std::size_t i = 0; i < names.size(); ++i) d[pyb::str(names[i])] = values[i];
+    return d;
+  }
+  bool identified() const noexcept { return est_->identified(); }
+
+ private:
+  void reserve(std::size_t more) {
+    t_.reserve(t_.size() + more);
+    v_.reserve(v_.size() + more);
+    y_.reserve(y_.size() + more);
+    ysim_.reserve(ysim_.size() + more);
+  }
+  double next_t() const noexcept { return static_cast<double>(t_.size()) * cfg_.dt_s; }
+  void step(double v, double y, double t) {
+    t_.push_back(t);
+    v_.push_back(v);
+    y_.push_back(y);
+    yhat_ = est_->step(v, y);
+    ysim_.push_back(est_->simulated());
+  }
+
+  EstimatorConfig cfg_;
+  EstimationJob job_;
+  std::unique_ptr<AnyEstimator> est_;
+  std::vector<double> t_, v_, y_, ysim_;
+  double yhat_ = 0.0;
+};
+
+Result estimate(const pyb::handle& t_obj, const pyb::handle& v_obj, const pyb::handle& y_obj, const std::string& model,
+                const std::string& preset, double outlier_gate, bool trace, bool intervals,
+                const pyb::kwargs& settings) {
+  EstimationJob job;
+  configure(job, model, preset, 1.0, settings);  // settings are checked before the data is looked at
+  const DoubleArray ta = as_doubles(t_obj, "t"), va = as_doubles(v_obj, "v"), ya = as_doubles(y_obj, "y");
+  const auto t = span_of(ta), v = span_of(va), y = span_of(ya);
+  if (v.size() != t.size())
+    throw InputError("", 0, "v", "has " + std::to_string(v.size()) + " samples, t has " + std::to_string(t.size()));
+  if (y.size() != t.size())
+    throw InputError("", 0, "y", "has " + std::to_string(y.size()) + " samples, t has " + std::to_string(t.size()));
+  const double dt = sample_period(t, "", {}, "t");
+  EstimatorConfig cfg = configure(job, model, preset, dt, settings, v, y);
+  validate(cfg, job, dt);
+  std::optional<AutoRun> ar;
+  std::optional<EstimateResult> res;
+  {
+    pyb::gil_scoped_release nogil;
+    ar.emplace(estimate_auto(cfg, v, y, trace, outlier_gate));
+    if (intervals) add_intervals(ar->run, ar->cfg, v, y);
+    res.emplace(score_estimate(ar->run.report, dt, job, t, y, ar->run.ysim));
+  }
+  EstimationRun* run = &ar->run;
+  Result r(std::move(*res));
+  r.yhat = to_numpy(std::move(run->yhat));
+  r.ysim = to_numpy(std::move(run->ysim));
+  if (trace) {
+    pyb::dict p;
+    for (std::size_t i = 0; i < run->param_names.size(); ++i)
+      p[pyb::str(run->param_names[i])] = to_numpy(std::move(run->params[i]));
+    r.params = p;
+  }
+  run->params.clear();
+  r.autorun = std::move(ar);
+  r.preset = to_string(preset_of(preset));
+  return r;
+}
+
+pyb::dict read_record(const std::string& path, const std::vector<std::string>& columns) {
+  Record rec = load_record(path, columns);
+  pyb::dict d;
+  d["file"] = rec.data.file;
+  d["dt_s"] = rec.dt_s;
+  const char* keys[] = {"t", "v", "y"};
+  for (std::size_t i = 0; i < 3; ++i) d[keys[i]] = to_numpy(std::move(rec.data.cols[i]));
+  return d;
+}
+
+}  // namespace
+
+void bind_estimate(pyb::module_& m) {
+  pyb::class_<Result>(m, "Result", "What `lash estimate` reports about one record (see to_dict()).")
+      .def("to_dict", &Result::to_dict,
+           "The object `lash estimate --json` prints for the same data and settings (the same library function).")
+      .def_property_readonly("json", [](const Result& r) { return r.json; }, "to_dict() as JSON text (one line).")
+      .def_property_readonly("model", [](const Result& r) { return std::string(to_string(r.res.report.model)); })
+      .def_property_readonly("samples", [](const Result& r) { return r.res.report.samples; },
+                             "Samples stepped, including skipped ones.")
+      .def_property_readonly("skipped", [](const Result& r) { return r.res.report.skipped; },
+                             "Samples skipped because v or y was not finite (NaN, inf).")
+      .def_property_readonly("identified", [](const Result& r) { return r.res.report.identified; },
+                             "True when the whole model is identified (the estimator's verdict).")
+      .def_property_readonly("dt_s", [](const Result& r) { return r.res.dt_s; },
+                             "Sample period used: mean step of t [s].")
+      .def_property_readonly("nrmse", [](const Result& r) { return r.res.nrmse; },
+                             "NRMSE of the free-run simulation over the window (fraction; NaN if empty).")
+      .def_property_readonly("nrmse_window_s", [](const Result& r) {
+        return pyb::make_tuple(r.res.nrmse_t0_s, r.res.nrmse_t1_s);
+      }, "NRMSE window (t0, t1) [s].")
+      .def_readonly("yhat", &Result::yhat, "One-step prediction per sample (lash.estimate only, else None).")
+      .def_readonly("ysim", &Result::ysim, "Free-run simulated output per sample (lash.estimate only, else None).")
+      .def_readonly("params", &Result::params,
+                    "With trace=True: dict name -> array of each parameter per sample (NaN while not identified).")
+      .def("__getitem__", [](const Result& r, const pyb::str& k) { return r.to_dict()[k]; })
+      .def("__repr__", [](const Result& r) { return "lash.Result(" + r.json + ")"; });
+
+  m.def("estimate", &estimate, pyb::arg("t"), pyb::arg("v"), pyb::arg("y"), pyb::kw_only(),
+        pyb::arg("model") = "deadzone-deadband", pyb::arg("preset") = "lash", pyb::arg("outlier_gate") = 12.0,
+        pyb::arg("trace") = false, pyb::arg("intervals") = true,
+        "estimate(t, v, y, *, model='deadzone-deadband', preset='lash', outlier_gate=12.0, trace=False,\n"
+        "         intervals=True, **settings) -> Result\n\n"
+        "As `lash estimate`: preset 'lash' (settings tuned to the data, guesses searched when not given) or\n"
+        "'thesis'; outlier_gate: isolated outliers of y beyond this many innovation scales are replaced (0 = off).\n"
+        "Runs one of lash's switching estimators (SPEC A4) over a whole record, as `lash estimate` does.\n"
+        "t [s] (strictly increasing, >= 3 samples; dt = mean step), v [input unit], y [output unit]: 1-D arrays\n"
+        "of equal length (converted to contiguous float64 if needed). NaN samples of v or y are skipped and\n"
+        "counted (Result.skipped). settings: the keys of an estimator config file (docs/identification.md),\n"
+        "e.g. guess_left=-350, guess_right=350, rls={'lambda': 0.99, 'p0': 1000}, noise={'filter_length': 5},\n"
+        "nrmse_window=(7.5, 30.0). intervals: the 95 % intervals (ci95, batch means: runs the estimator once\n"
+        "more over sections of the record), as `lash estimate`. Raises lash.InputError (a ValueError) naming the key.");
+
+  pyb::class_<Estimator>(m, "Estimator",
+                         "Estimator(model, dt_s, *, preset='thesis', **settings): one estimator fed sample by sample\n"
+                         "(streaming): the preset's static settings (nothing is chosen from data not seen yet), no\n"
+                         "guess search, no outlier gate. dt_s: sample period [s]; settings as for lash.estimate.\n"
+                         "The k-th sample is at t = k*dt_s.")
+      .def(pyb::init<const std::string&, double, const std::string&, const pyb::kwargs&>(), pyb::arg("model"),
+           pyb::arg("dt_s"), pyb::kw_only(), pyb::arg("preset") = "thesis")
+      .def("update", &Estimator::update, pyb::arg("v"), pyb::arg("y"), pyb::arg("t_s") = pyb::none(),
+           "update(v, y, t_s=None) -> yhat: one sample v [input unit], y [output unit] at time t_s [s]\n"
+           "(default k*dt_s; only the NRMSE window uses it). Returns the one-step prediction [output unit].")
+      .def("update_many", &Estimator::update_many, pyb::arg("v"), pyb::arg("y"), pyb::arg("t") = pyb::none(),
+           "update_many(v, y, t=None) -> yhat array: 1-D arrays of equal length (t [s] optional, as in update).\n"
+           "Same bits as update() sample by sample.")
+      .def("result", &Estimator::result, pyb::kw_only(), pyb::arg("intervals") = true,
+           "The Result after the samples so far (as lash.estimate would report; intervals as there).")
+      .def("reset", &Estimator::reset, "Back to the state before the first sample (same settings).")
+      .def_property_readonly("samples", &Estimator::samples, "Samples fed so far.")
+      .def_property_readonly("dt_s", &Estimator::dt_s, "Sample period [s].")
+      .def_property_readonly("identified", &Estimator::identified, "The estimator's verdict now.")
+      .def("params", &Estimator::params, "Current parameters by name (a1_r, b1_r, c_r, d_r, ...; NaN = not identified).");
+
+  m.def("read_record", &read_record, pyb::arg("path"), pyb::arg("columns") = std::vector<std::string>{"t", "v", "y"},
+        "read_record(path, columns=['t','v','y']) -> dict(t, v, y, dt_s, file)\n\n"
+        "Loads a record (CSV or MAT) as `lash estimate` does: t [s] strictly increasing, dt_s = its mean step.");
+}
+
+}  // namespace lash::py

@@ -1,0 +1,105 @@
+"""lash.estimate against `lash estimate --json`, and the streaming Estimator against both.
+
+Must show: on E2 data (config/scenarios/e2.toml settings) lash.estimate(...).to_dict() equals the
+CLI's JSON object key for key (floats to 1e-12 relative); Estimator.update sample by sample equals
+update_many and lash.estimate bit for bit."""
+import json
+import math
+import os
+
+import numpy as np
+
+import lash
+from conftest import E2_SETTINGS, SRC, read_csv, run_lash, write_settings_toml
+
+
+def same(a, b, rel=1e-12, path="$"):
+    """Key-for-key equality of two JSON objects; floats to `rel` relative."""
+    assert type(a) is type(b) or (isinstance(a, (int, float)) and isinstance(b, (int, float))), (path, a, b)
+    if isinstance(a, dict):
+        assert list(a) == list(b), (path, list(a), list(b))
+        for k in a:
+            same(a[k], b[k], rel, path + "." + k)
+    elif isinstance(a, list):
+        assert len(a) == len(b), path
+        for i, (x, y) in enumerate(zip(a, b)):
+            same(x, y, rel, "%s[%d]" % (path, i))
+    elif isinstance(a, float) or isinstance(b, float):
+        assert math.isclose(a, b, rel_tol=rel, abs_tol=0.0) or a == b, (path, a, b)
+    else:
+        assert a == b, (path, a, b)
+
+
+def test_e2_equals_cli_json(e2_csv, tmp_path):
+    cfg = tmp_path / "e2.toml"
+    write_settings_toml(cfg, "deadzone-deadband", E2_SETTINGS)
+    cli = json.loads(run_lash("estimate", e2_csv, "--config", cfg, "--json"))
+    d = read_csv(e2_csv)
+    r = lash.estimate(d["t"], d["v"], d["y"], model="deadzone-deadband", **E2_SETTINGS)
+    py = r.to_dict()
+    same(py, cli)
+    assert py["preset"] == "lash" and "outliers" in py
+    # the comparison covers numbers, not nulls
+    assert all(py[s][k] is not None for s in ("right", "left") for k in ("a1", "b1", "c", "d")), py
+    assert abs(py["right"]["c"] - 200.0) < 10 and abs(py["left"]["c"] + 300.0) < 15, py
+    assert r.samples == 40000 and r.skipped == 0 and r.dt_s == (d["t"][-1] - d["t"][0]) / 39999
+
+
+def test_linear_and_other_models_equal_cli(e2_csv):
+    d = read_csv(e2_csv)
+    for model, extra in [("linear", []), ("input-deadzone", ["--guess-left", "-350", "--guess-right", "350"]),
+                         ("deadzone-deadband", ["--guess-left", "-350", "--guess-right", "350", "--lambda", "0.995"])]:
+        cli = json.loads(run_lash("estimate", e2_csv, "--model", model, *extra, "--json"))
+        kw = {}
+        if extra:
+            kw = dict(guess_left=-350.0, guess_right=350.0)
+        if "--lambda" in extra:
+            kw["rls"] = {"lambda": 0.995}
+        same(lash.estimate(d["t"], d["v"], d["y"], model=model, **kw).to_dict(), cli)
+
+
+def test_streaming_equals_batch_bit_for_bit(e2_csv):
+    d = read_csv(e2_csv)
+    t, v, y = d["t"][:12000], d["v"][:12000], d["y"][:12000]
+    n = len(t)
+    dt = (t[-1] - t[0]) / (n - 1)  # lash.estimate's dt: the mean step of t
+    # the streaming estimator has no data to choose settings from, no guess search, no outlier gate:
+    # lash.estimate with the thesis preset and the gate off runs exactly that estimator
+    batch = lash.estimate(t, v, y, preset="thesis", outlier_gate=0, **E2_SETTINGS)
+
+    one = lash.Estimator("deadzone-deadband", dt, **E2_SETTINGS)
+    yhat1 = np.array([one.update(a, b, t_s=ts) for a, b, ts in zip(v, y, t)])
+    many = lash.Estimator("deadzone-deadband", dt, **E2_SETTINGS)
+    yhat2 = np.concatenate([many.update_many(v[:5000], y[:5000], t=t[:5000]),
+                            many.update_many(v[5000:], y[5000:], t=t[5000:])])
+    assert yhat1.tobytes() == yhat2.tobytes() == batch.yhat.tobytes()
+    # .json is the library's estimate_json (to_dict() adds the guess search and gate report)
+    assert one.result().json == many.result().json == batch.json
+    assert one.params().keys() == many.params().keys()
+    # reset returns to the first sample's state
+    many.reset()
+    assert many.samples == 0
+    assert many.update_many(v, y, t=t).tobytes() == batch.yhat.tobytes()
+    assert many.result().json == batch.json
+
+
+def test_default_time_base_is_k_dt():
+    """Without t, sample k is at k*dt_s: equals lash.estimate on t = arange(n)*dt when dt is exact."""
+    dt = 2.0 ** -7  # exact in binary, so mean step of k*dt is dt again
+    plant = lash.Plant.from_toml(os.path.join(SRC, "config/plants/thesis_eq34.toml"), dt_s=dt)
+    v = lash.signal("sine", 60.0, dt, amplitude=600.0)
+    tr = plant.simulate(v, noise_variance=10.0, seed=4)
+    e = lash.Estimator("deadzone-deadband", dt, guess_left=-350, guess_right=350, nrmse_window=[5.0, 50.0])
+    e.update_many(tr["v"], tr["y"])
+    b = lash.estimate(np.arange(len(v)) * dt, tr["v"], tr["y"], guess_left=-350, guess_right=350,
+                      nrmse_window=[5.0, 50.0], preset="thesis", outlier_gate=0)
+    assert e.result().json == b.json
+    assert b.nrmse_window_s == (5.0, 50.0)
+
+
+def test_trace_columns(e2_csv):
+    d = read_csv(e2_csv)
+    r = lash.estimate(d["t"], d["v"], d["y"], trace=True, **E2_SETTINGS)
+    assert list(r.params) == ["a1_r", "b1_r", "c_r", "d_r", "a1_l", "b1_l", "c_l", "d_l"]
+    assert math.isnan(r.params["c_r"][0])
+    assert r.params["c_r"][-1] == r.to_dict()["right"]["c"]
