@@ -82,6 +82,7 @@ hil::BenchSettings load_settings(const CommonOptions& o) {
   const std::filesystem::path file =
       o.config.empty() ? hil::default_settings_path(source_dir()) : std::filesystem::path(o.config);
   hil::BenchSettings s = hil::load_bench_settings(file);
+  for (const auto& w : s.warnings) fmt::print(stderr, "lash: warning: {}\n", w);
   if (!o.bus.empty()) s.bus = o.bus;
   if (o.step_ms != 0.0) {
     if (!(o.step_ms > 0) || !std::isfinite(o.step_ms)) throw InputError("", 0, "--step-ms", "must be > 0 [ms]");

@@ -49,32 +49,14 @@ BenchSettings load_bench_settings(const std::filesystem::path& file) {
   if (cnode != nullptr && cnode->is_string()) {
     // The control module's gains file (e.g. config/control/thesis_gains.toml).
     const double dt_keep = s.controller.pid.dt_s;
-    s.controller = load_controller_config(dir / t.string("controller"));
+    s.controller =
+        load_controller_config(dir / t.string("controller"), [&](const std::string& w) { s.warnings.push_back(w); });
     s.controller.pid.dt_s = dt_keep;
   } else if (auto c = t.table_opt("controller")) {
-    auto& g = s.controller.pid.gains;
-    g.kp = c->number_or("kp", g.kp);
-    g.ki_per_s = c->number_or("ki_per_s", g.ki_per_s);
-    g.kd_s = c->number_or("kd_s", g.kd_s);
-    g.n_per_s = c->number_or("n_per_s", g.n_per_s);
-    if (auto m = c->string_opt("integrator")) {
-      try {
-        s.controller.pid.integrator = parse_integrator_method(m->c_str());
-      } catch (const std::invalid_argument& e) {
-        c->fail("integrator", e.what());
-      }
-    }
-    const double dzi = c->number_or("deadzone_inverse_mA", 0.97 * 288.0);
-    if (!(dzi >= 0)) c->fail("deadzone_inverse_mA", "must be >= 0 [mA]");
-    s.controller.dz_inverse.offset_right = dzi;
-    s.controller.dz_inverse.offset_left = dzi;
-    s.controller.current_min_mA = c->number_or("current_min_mA", 0.0);
-    s.controller.current_max_mA = c->number_or("current_max_mA", 2000.0);
-    if (!(s.controller.current_min_mA <= s.controller.current_max_mA))
-      c->fail("current_max_mA", "must be >= current_min_mA");
-    for (const auto& [key, v] : {std::pair<const char*, double>{"kp", g.kp}, {"ki_per_s", g.ki_per_s},
-                                  {"kd_s", g.kd_s}, {"n_per_s", g.n_per_s}})
-      if (!(v >= 0) || !std::isfinite(v)) c->fail(key, "must be a finite number >= 0");
+    // The same schema as a gains file (control/gains_file.hpp), inline.
+    const double dt_keep = s.controller.pid.dt_s;
+    s.controller = read_controller_config(*c, [&](const std::string& w) { s.warnings.push_back(w); });
+    s.controller.pid.dt_s = dt_keep;
     c->finish();
   }
   if (auto m = t.table_opt("master")) {

@@ -188,4 +188,51 @@ TEST(GainsFile, RejectsUnknownKeyNamingLine) {
   EXPECT_THROW(load_controller_config(path), InputError);
 }
 
+TEST(GainsFile, OneSchemaOldKeysAreDeprecatedAliases) {
+  const std::string dir = ::testing::TempDir();
+  auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir + "/" + name) << text;
+    return dir + "/" + name;
+  };
+  const std::string canon = write("canon.toml",
+                                  "[pid]\nkp = 1.5\nki_per_s = 20\nkd_s = 0.01\nn_per_s = 50\ndt_s = 0.002\n"
+                                  "[deadzone_inverse]\noffset_mA = 100\n[saturation]\nmin_mA = 10\nmax_mA = 1500\n");
+  const std::string old = write("old.toml",
+                                "[pid]\nkp = 1.5\nki = 20\nkd = 0.01\nn = 50\ndt = 0.002\n"
+                                "[deadzone_inverse]\noffset_mA = 100\n[saturation]\nmin_mA = 10\nmax_mA = 1500\n");
+  std::vector<std::string> w_canon, w_old;
+  const ControllerConfig a = load_controller_config(canon, [&](const std::string& w) { w_canon.push_back(w); });
+  const ControllerConfig b = load_controller_config(old, [&](const std::string& w) { w_old.push_back(w); });
+  EXPECT_TRUE(w_canon.empty());
+  ASSERT_EQ(w_old.size(), 4u);  // ki, kd, n, dt
+  EXPECT_NE(w_old[0].find("old.toml:3"), std::string::npos) << w_old[0];
+  EXPECT_NE(w_old[0].find("pid.ki_per_s"), std::string::npos) << w_old[0];
+  for (const ControllerConfig* c : {&a, &b}) {
+    EXPECT_EQ(c->pid.gains.kp, 1.5);
+    EXPECT_EQ(c->pid.gains.ki_per_s, 20.0);
+    EXPECT_EQ(c->pid.gains.kd_s, 0.01);
+    EXPECT_EQ(c->pid.gains.n_per_s, 50.0);
+    EXPECT_EQ(c->pid.dt_s, 0.002);
+    EXPECT_EQ(c->dz_inverse.offset_right, 100.0);
+    EXPECT_EQ(c->current_min_mA, 10.0);
+    EXPECT_EQ(c->current_max_mA, 1500.0);
+  }
+  // The same setting under its new and its old name: refused, naming the second one's line.
+  const std::string both = write("both.toml", "[pid]\nkp = 1\nki_per_s = 2\nki = 2\nkd_s = 0\n");
+  try {
+    load_controller_config(both, [](const std::string&) {});
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.line(), 4);
+    EXPECT_NE(std::string(e.what()).find("given twice"), std::string::npos);
+  }
+  // The file written by `lash tune` reads back without a warning.
+  const std::string round = write("round.toml", controller_config_toml(a, "round trip"));
+  std::vector<std::string> w_round;
+  const ControllerConfig c = load_controller_config(round, [&](const std::string& w) { w_round.push_back(w); });
+  EXPECT_TRUE(w_round.empty());
+  EXPECT_EQ(c.pid.gains.ki_per_s, 20.0);
+  EXPECT_EQ(c.current_max_mA, 1500.0);
+}
+
 }  // namespace

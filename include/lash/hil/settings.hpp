@@ -25,6 +25,7 @@ struct BenchSettings {
   double dto_timeout_s = 2.0;
   std::uint32_t fault_missed_periods = 3;
   std::uint32_t cro_retry_steps = 10;
+  std::vector<std::string> warnings;       ///< deprecated keys read (the CLI prints them)
   /// Sets step_s in plant and controller (after a --step-ms override).
   void set_step(double step_s_new);
 };
