@@ -398,7 +398,7 @@ void write_all(int fd, const void* p, std::size_t n) {
   while (n > 0) {
     const ssize_t w = ::write(fd, b, n);
     if (w < 0 && errno == EINTR) continue;
-    if (w <= 0) throw std::runtime_error(std::string("cannot hand the run over: ") + std::strerror(errno));
+    if (w <= 0) throw SystemError(std::string("cannot hand the run over: ") + std::strerror(errno));
     b += w;
     n -= static_cast<std::size_t>(w);
   }

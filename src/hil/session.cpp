@@ -12,7 +12,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <system_error>
 #include <thread>
 
 #include "lash/hil/netns.hpp"
@@ -41,7 +40,7 @@ struct Child {
 
 int make_memfd(const char* name) {
   const int fd = memfd_create(name, MFD_CLOEXEC);
-  if (fd < 0) throw std::system_error(errno, std::generic_category(), "memfd_create");
+  if (fd < 0) throw SystemError(std::string("memfd_create failed: ") + std::strerror(errno));
   return fd;
 }
 
@@ -49,10 +48,10 @@ Child spawn(const std::string& exe, std::vector<std::string> args, bool pipe_std
   Child c;
   c.result_fd = make_memfd(name);
   int fds[2] = {-1, -1};
-  if (pipe_stdout && pipe2(fds, O_CLOEXEC) != 0) throw std::system_error(errno, std::generic_category(), "pipe");
+  if (pipe_stdout && pipe2(fds, O_CLOEXEC) != 0) throw SystemError(std::string("pipe failed: ") + std::strerror(errno));
   const pid_t parent = getpid();
   const pid_t pid = fork();
-  if (pid < 0) throw std::system_error(errno, std::generic_category(), "fork");
+  if (pid < 0) throw SystemError(std::string("fork failed: ") + std::strerror(errno));
   if (pid == 0) {
     // The node dies with the session, whatever kills the session.
     prctl(PR_SET_PDEATHSIG, SIGTERM);
@@ -257,8 +256,8 @@ RunReport Session::run(const std::function<void(const std::string&)>& progress) 
   if (!start_slave()) {
     const int sig = g_stop_signal.load();
     for (auto& s : slaves) cleanup(s);
-    if (sig != 0) throw std::runtime_error("interrupted by signal " + std::to_string(sig) + " before the slave was ready");
-    throw std::runtime_error("the slave did not start (no 'ready' line within 10 s)");
+    if (sig != 0) throw RunError("interrupted by signal " + std::to_string(sig) + " before the slave was ready");
+    throw RunError("the slave did not start (no 'ready' line within 10 s)");
   }
   std::vector<std::string> margs{"lash", "hil", "master"};
   for (auto& x : loop_args(o_.loop, o_)) margs.push_back(x);

@@ -57,12 +57,10 @@ constexpr std::optional<Side> guess_side(double v1, const EstimatorConfig& c) no
 /// over every sample when the record ends before that.
 struct FitWindow {
   std::uint64_t k0 = 0, k = 0;
-  NrmseAccumulator window, all;
-  void add(double y, double ysim) noexcept {
-    all.add(y, ysim);
-    if (k++ >= k0) window.add(y, ysim);
-  }
-  double nrmse() const noexcept { return window.n > 0 ? window.value() : all.value(); }
+  NrmseAccumulator window, before;  // t ≥ fit_start_s, and the samples before it
+  void add(double y, double ysim) noexcept { (k++ >= k0 ? window : before).add(y, ysim); }
+  /// The window's NRMSE; the whole record's when it ended before the window began.
+  double nrmse() const noexcept { return window.n > 0 ? window.value() : before.value(); }
 };
 }  // namespace detail
 

@@ -21,13 +21,14 @@ struct NrmseAccumulator {
   std::size_t n = 0;     ///< samples added
   void add(double y, double ysim) noexcept {
     const double e = y - ysim;
-    sum_sq += std::isfinite(e) ? e * e : std::numeric_limits<double>::infinity();
+    sum_sq += e * e;  // a non-finite error makes the sum inf or NaN; value() reads both as inf
     max_abs = std::max(max_abs, std::fabs(y));
     ++n;
   }
   /// The NRMSE of the samples added so far (a fraction); NaN when none or all y = 0.
   double value() const noexcept {
     if (n == 0 || max_abs == 0.0) return std::numeric_limits<double>::quiet_NaN();
+    if (!std::isfinite(sum_sq)) return std::numeric_limits<double>::infinity();
     return std::sqrt(sum_sq / static_cast<double>(n)) / max_abs;
   }
 };
