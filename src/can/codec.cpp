@@ -271,8 +271,8 @@ MessageCodec::MessageCodec(const dbc::Message& message) : message_(message) {
     l.offset = c.offset_;
     l.min_phys = c.has_range_ ? c.min_phys_ : -std::numeric_limits<double>::infinity();
     l.max_phys = c.has_range_ ? c.max_phys_ : std::numeric_limits<double>::infinity();
-    l.raw_lo = c.raw_lo_;
-    l.raw_hi_excl = c.raw_hi_excl_;
+    l.raw_lo = c.signed_ ? -static_cast<std::int64_t>(c.mask_ >> 1) - 1 : 0;
+    l.raw_span = c.mask_;
     l.raw_min_bits = c.signed_ ? (c.mask_ >> 1) + 1 : 0;  // most negative / 0
     l.raw_max_bits = c.signed_ ? c.mask_ >> 1 : c.mask_;
     l.index = static_cast<std::uint32_t>(i);
@@ -281,6 +281,8 @@ MessageCodec::MessageCodec(const dbc::Message& message) : message_(message) {
     l.word = sg.byte_order == dbc::ByteOrder::motorola ? 1 : 0;
     lanes_.push_back(l);
   }
+  std::stable_partition(lanes_.begin(), lanes_.end(), [](const Lane& l) { return l.word == 0; });
+  intel_lanes_ = static_cast<std::uint32_t>(std::count_if(lanes_.begin(), lanes_.end(), [](const Lane& l) { return l.word == 0; }));
   if (packed_)
     for (std::size_t i = 0; i < codecs_.size(); ++i) {
       const SignalCodec& c = codecs_[i];
@@ -339,46 +341,59 @@ bool MessageCodec::decode(std::span<const std::uint8_t> data, std::span<double> 
   return true;
 }
 
+inline std::uint64_t MessageCodec::lane_raw(const Lane& l, double p, std::uint32_t& clamped) const noexcept {
+  // NaN goes through the clamp unchanged and fails the guard below.
+  const double pc = std::min(std::max(p, l.min_phys), l.max_phys);  // ±inf without a DBC range
+  // Multiply by 1/factor and round half to even without libm: adding and subtracting
+  // 2^52 with q's sign leaves the nearest integer (the FPU rounds ties to even).
+  const double q = (pc - l.offset) * l.inv_factor;
+  const double m = std::copysign(4503599627370496.0, q);
+  const double r = (q + m) - m;
+  // Where the product could round differently from the exact quotient (within ~1e-12
+  // relative of a .5 tie), for |q| ≥ 5e11, NaN and ±inf, the reference to_raw() decides;
+  // otherwise |r| < 2^63 and one unsigned compare checks the bit field.
+  if (!(std::fabs(q - r) < 0.5 - (std::fabs(q) + 1.0) * 1e-12)) [[unlikely]] {
+    bool cl = false;
+    const std::uint64_t raw = codecs_[l.index].to_raw(p, cl);
+    clamped += cl ? 1u : 0u;
+    return raw;
+  }
+  const auto ir = static_cast<std::int64_t>(r);
+  if (static_cast<std::uint64_t>(ir) - static_cast<std::uint64_t>(l.raw_lo) > l.raw_span) [[unlikely]] {
+    ++clamped;
+    return ir < l.raw_lo ? l.raw_min_bits : l.raw_max_bits;
+  }
+  clamped += pc != p ? 1u : 0u;
+  return static_cast<std::uint64_t>(ir) & l.mask;
+}
+
 template <bool Mux>
 std::uint32_t MessageCodec::encode_packed(std::span<const double> values, std::uint64_t set[2], std::uint64_t clear[2]) noexcept {
   std::uint32_t clamped = 0;
-  for (const Lane& l : lanes_) {
+  const Lane* const lanes = lanes_.data();
+  const std::uint32_t n = static_cast<std::uint32_t>(lanes_.size());
+  // Intel lanes, then Motorola lanes, each into a register accumulator.
+  std::uint64_t s0 = 0, s1 = 0, c0 = 0, c1 = 0;
+  for (std::uint32_t k = 0; k < intel_lanes_; ++k) {
+    const Lane& l = lanes[k];
     if constexpr (Mux) {
       if (!present_[l.index]) continue;
-      clear[l.word] |= l.mask << l.lo;
+      c0 |= l.mask << l.lo;
     }
-    const double p = values[l.index];
-    std::uint64_t raw;
-    if (p != p) [[unlikely]] {  // NaN
-      raw = 0;
-      ++clamped;
-    } else {
-      const double pc = std::min(std::max(p, l.min_phys), l.max_phys);  // ±inf without a DBC range
-      std::uint32_t c = pc != p ? 1u : 0u;
-      // Multiply by 1/factor; where that could round differently from the exact quotient
-      // (within ~1e-12 relative of a .5 tie, or beyond 2^51) divide instead, so the result
-      // is always round_half_even((p - offset) / factor).
-      const double q = (pc - l.offset) * l.inv_factor;
-      // Branch-free round half to even for |q| < 2^52: adding and subtracting 2^52 with
-      // q's sign leaves the nearest integer (the FPU rounds ties to even).
-      const double m = std::copysign(4503599627370496.0, q);
-      double r = (q + m) - m;
-      const double aq = std::fabs(q);
-      if (aq >= 2251799813685248.0 || std::fabs(q - r) >= 0.5 - (aq + 1.0) * 1e-12) [[unlikely]]
-        r = round_half_even((pc - l.offset) / l.factor);
-      if (r < l.raw_lo) [[unlikely]] {
-        raw = l.raw_min_bits;
-        c = 1;
-      } else if (r >= l.raw_hi_excl) [[unlikely]] {
-        raw = l.raw_max_bits;
-        c = 1;
-      } else {
-        raw = static_cast<std::uint64_t>(static_cast<std::int64_t>(r)) & l.mask;
-      }
-      clamped += c;
-    }
-    set[l.word] |= raw << l.lo;
+    s0 |= lane_raw(l, values[l.index], clamped) << l.lo;
   }
+  for (std::uint32_t k = intel_lanes_; k < n; ++k) {
+    const Lane& l = lanes[k];
+    if constexpr (Mux) {
+      if (!present_[l.index]) continue;
+      c1 |= l.mask << l.lo;
+    }
+    s1 |= lane_raw(l, values[l.index], clamped) << l.lo;
+  }
+  set[0] |= s0;
+  set[1] |= s1;
+  clear[0] |= c0;
+  clear[1] |= c1;
   for (const std::uint32_t i : slow_) {
     if (Mux && !present_[i]) continue;
     const SignalCodec& c = codecs_[i];
