@@ -273,6 +273,10 @@ MessageCodec::MessageCodec(const dbc::Message& message) : message_(message) {
     l.max_phys = c.has_range_ ? c.max_phys_ : std::numeric_limits<double>::infinity();
     l.raw_lo = c.signed_ ? -static_cast<std::int64_t>(c.mask_ >> 1) - 1 : 0;
     l.raw_span = c.mask_;
+    // Largest |raw| of the field + 1, times 2^-50 (> 3·2^-53, the relative gap between the
+    // product and the quotient): fields over ~48 bits get half_tol ≤ 0 and always take
+    // the reference path, which stays exact.
+    l.half_tol = 0.5 - (std::ldexp(1.0, static_cast<int>(c.signed_ ? c.length_ - 1 : c.length_)) + 1.0) * std::ldexp(1.0, -50);
     l.raw_min_bits = c.signed_ ? (c.mask_ >> 1) + 1 : 0;  // most negative / 0
     l.raw_max_bits = c.signed_ ? c.mask_ >> 1 : c.mask_;
     l.index = static_cast<std::uint32_t>(i);
@@ -342,29 +346,28 @@ bool MessageCodec::decode(std::span<const std::uint8_t> data, std::span<double> 
 }
 
 inline std::uint64_t MessageCodec::lane_raw(const Lane& l, double p, std::uint32_t& clamped) const noexcept {
-  // NaN goes through the clamp unchanged and fails the guard below.
-  const double pc = std::min(std::max(p, l.min_phys), l.max_phys);  // ±inf without a DBC range
-  // Multiply by 1/factor and round half to even without libm: adding and subtracting
-  // 2^52 with q's sign leaves the nearest integer (the FPU rounds ties to even).
-  const double q = (pc - l.offset) * l.inv_factor;
-  const double m = std::copysign(4503599627370496.0, q);
-  const double r = (q + m) - m;
-  // Where the product could round differently from the exact quotient (within ~1e-12
-  // relative of a .5 tie), for |q| ≥ 5e11, NaN and ±inf, the reference to_raw() decides;
-  // otherwise |r| < 2^63 and one unsigned compare checks the bit field.
-  if (!(std::fabs(q - r) < 0.5 - (std::fabs(q) + 1.0) * 1e-12)) [[unlikely]] {
-    bool cl = false;
-    const std::uint64_t raw = codecs_[l.index].to_raw(p, cl);
-    clamped += cl ? 1u : 0u;
-    return raw;
+  // Fast path: p inside [min|max] (±inf without a DBC range), the product rounds like the
+  // exact quotient, the result fits the field. Anything else (NaN, ±inf, a value to clamp,
+  // a product within rounding error of a .5 tie) is decided by the reference to_raw().
+  if (!(p < l.min_phys) && !(p > l.max_phys)) [[likely]] {
+    const double q = (p - l.offset) * l.inv_factor;
+    // Round half to even without libm: adding and subtracting 2^52 with q's sign leaves
+    // the nearest integer (the FPU rounds ties to even).
+    const double m = std::copysign(4503599627370496.0, q);
+    const double r = (q + m) - m;
+    // |q·(1/f) − q/f| ≤ 3·2^-53·|q|; for |q| ≤ (largest raw + 1) half_tol keeps that gap
+    // away from a tie (see the constructor); a larger |q| leaves the field and takes the
+    // reference path below. NaN fails this test.
+    if (std::fabs(q - r) < l.half_tol) [[likely]] {
+      const auto ir = static_cast<std::int64_t>(r);  // |r| ≤ 2^52 here
+      if (static_cast<std::uint64_t>(ir) - static_cast<std::uint64_t>(l.raw_lo) <= l.raw_span) [[likely]]
+        return static_cast<std::uint64_t>(ir) & l.mask;
+    }
   }
-  const auto ir = static_cast<std::int64_t>(r);
-  if (static_cast<std::uint64_t>(ir) - static_cast<std::uint64_t>(l.raw_lo) > l.raw_span) [[unlikely]] {
-    ++clamped;
-    return ir < l.raw_lo ? l.raw_min_bits : l.raw_max_bits;
-  }
-  clamped += pc != p ? 1u : 0u;
-  return static_cast<std::uint64_t>(ir) & l.mask;
+  bool cl = false;
+  const std::uint64_t raw = codecs_[l.index].to_raw(p, cl);
+  clamped += cl ? 1u : 0u;
+  return raw;
 }
 
 template <bool Mux>

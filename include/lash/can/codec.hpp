@@ -157,6 +157,7 @@ class MessageCodec {
   /// fields; float signals and unsigned 64-bit fields go through `slow_`.
   struct Lane {
     double inv_factor, offset, min_phys, max_phys, factor;
+    double half_tol;         ///< 0.5 less the largest gap between p×(1/factor) and p/factor over the field
     std::int64_t raw_lo;     ///< smallest raw value of the field (integer)
     std::uint64_t raw_span;  ///< largest - smallest raw value: in range iff raw - raw_lo <= raw_span (unsigned)
     std::uint64_t mask;
