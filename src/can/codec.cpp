@@ -277,11 +277,9 @@ MessageCodec::MessageCodec(const dbc::Message& message) : message_(message) {
     // product and the quotient): fields over ~48 bits get half_tol ≤ 0 and always take
     // the reference path, which stays exact.
     l.half_tol = 0.5 - (std::ldexp(1.0, static_cast<int>(c.signed_ ? c.length_ - 1 : c.length_)) + 1.0) * std::ldexp(1.0, -50);
-    l.raw_min_bits = c.signed_ ? (c.mask_ >> 1) + 1 : 0;  // most negative / 0
-    l.raw_max_bits = c.signed_ ? c.mask_ >> 1 : c.mask_;
+    l.sign = c.signed_ ? (c.mask_ >> 1) + 1 : 0;
     l.index = static_cast<std::uint32_t>(i);
     l.lo = static_cast<std::uint8_t>(c.lo_base_);  // window at byte 0
-    l.sext = static_cast<std::uint8_t>(c.signed_ ? 64 - c.length_ : 0);
     l.word = sg.byte_order == dbc::ByteOrder::motorola ? 1 : 0;
     lanes_.push_back(l);
   }
@@ -328,10 +326,14 @@ bool MessageCodec::decode(std::span<const std::uint8_t> data, std::span<double> 
   if (packed_) {
     const std::uint64_t le = load_le(data, message_.size);
     const std::uint64_t words[2] = {le, __builtin_bswap64(le)};  // [word]
-    for (const Lane& l : lanes_) {
-      const std::uint64_t raw = (words[l.word] >> l.lo) & l.mask;
-      values[l.index] = static_cast<double>(static_cast<std::int64_t>(raw << l.sext) >> l.sext) * l.factor + l.offset;
-    }
+    const Lane* const lanes = lanes_.data();
+    const std::uint32_t n = static_cast<std::uint32_t>(lanes_.size());
+    const auto lane = [&](const Lane& l, std::uint64_t word) {
+      const std::uint64_t raw = (word >> l.lo) & l.mask;
+      values[l.index] = static_cast<double>(static_cast<std::int64_t>((raw ^ l.sign) - l.sign)) * l.factor + l.offset;
+    };
+    for (std::uint32_t k = 0; k < intel_lanes_; ++k) lane(lanes[k], words[0]);
+    for (std::uint32_t k = intel_lanes_; k < n; ++k) lane(lanes[k], words[1]);
     for (const std::uint32_t i : slow_) {
       const SignalCodec& c = codecs_[i];
       values[i] = c.to_physical((words[c.signal_.byte_order == dbc::ByteOrder::motorola ? 1 : 0] >> c.lo_base_) & c.mask_);
