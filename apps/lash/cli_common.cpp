@@ -1,21 +1,29 @@
 #include "cli_common.hpp"
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 
-#include <fmt/core.h>
-
 namespace lash::cli {
 
-int guarded(const std::function<int()>& fn) {
+int guarded(const std::function<int()>& fn) noexcept {
   try {
     return fn();
   } catch (const InputError& e) {
-    fmt::print(stderr, "lash: error: {}\n", e.what());
+    std::fprintf(stderr, "lash: error: %s\n", e.what());
     return kExitBadInput;
-  } catch (const std::invalid_argument& e) {
-    fmt::print(stderr, "lash: error: {}\n", e.what());
+  } catch (const std::invalid_argument& e) {  // a config struct's validate(): values a person chose
+    std::fprintf(stderr, "lash: error: %s\n", e.what());
     return kExitBadInput;
+  } catch (const Error& e) {
+    std::fprintf(stderr, "lash: error: %s\n", e.what());
+    return kExitFailed;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "lash: internal error: %s\n", e.what());
+    return kExitFailed;
+  } catch (...) {
+    std::fputs("lash: internal error: unknown exception\n", stderr);
+    return kExitFailed;
   }
 }
 

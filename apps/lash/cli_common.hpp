@@ -40,8 +40,10 @@ int demo_e3_campaign(const std::string& out_dir);
 Command add_can(CLI::App& app);
 Command add_hil(CLI::App& app);
 
-/// Runs `fn`, mapping InputError and std::invalid_argument to exit 2 with a message on stderr.
-int guarded(const std::function<int()>& fn);
+/// The one catch-all (main): runs `fn`; InputError and std::invalid_argument → exit 2,
+/// any other lash::Error, std::exception or unknown exception → exit 1; a message on stderr,
+/// never an abort.
+int guarded(const std::function<int()>& fn) noexcept;
 
 /// Writes named columns as CSV (round-trip precision) atomically to `path`.
 void write_columns_csv(const std::string& path, const std::vector<std::string>& names,

@@ -84,7 +84,7 @@ int run(const EstimateOptions& o) {
   EstimationJob job;
   (void)assemble(o, model, preset, nullptr, job);
 
-  const Record rec = load_record(o.data, job.columns);
+  const Record rec = load_record(o.data, job.columns, o.strict);
   EstimatorConfig cfg = assemble(o, model, preset, &rec, job);
   cfg.fit_start_s = job.nrmse_t0_s;  // the verdict's fit window starts where the reported NRMSE's does
   const bool keep = !o.out.empty() || !o.plot.empty();
@@ -139,7 +139,8 @@ int run(const EstimateOptions& o) {
     if (!tmp.empty()) std::filesystem::remove(tmp);
   }
 
-  const ReportFit rf{fit, job.nrmse_t0_s, t1};
+  const ReportFit rf{fit, job.nrmse_t0_s, t1, rec.skipped_rows(), rec.data.first_skipped_line, rec.gap_rows().size(),
+                     rec.sampling.median_dt};
   if (o.json) {
     auto j = nlohmann::ordered_json::parse(estimate_json(run.report, rf));
     if (j.contains("right")) put_guess(j["right"], ar.right);
@@ -193,7 +194,8 @@ Command add_estimate(CLI::App& app) {
   sub->add_option("--accel-limit", o->accel_limit, "coupled-carts: max |acceleration| for stage 1 [y unit/s^2]");
   sub->add_option("--stage2-start", o->stage2_start, "coupled-carts: start of the deadband estimation [s]");
   sub->add_option("--zero-threshold", o->zero_threshold, "output-deadzone: |y| at or below this counts as 0");
-  sub->add_option("--columns", o->columns, "Names of the t,v,y columns, comma-separated (default t,v,y)");
+  sub->add_option("--columns", o->columns, "The t,v,y columns by name or 0-based index, comma-separated (default t,v,y)");
+  sub->add_flag("--strict", o->strict, "A row with a non-finite value (nan, inf, empty) is an error instead of skipped");
   sub->add_option("--nrmse-window", o->nrmse_window, "NRMSE window T0 T1 [s] (default 7.5 to the end)")
       ->expected(2);
   sub->add_option("-o,--output", o->out, "Trace CSV: t, y, yhat, y_sim and every parameter per step");

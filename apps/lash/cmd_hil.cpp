@@ -542,12 +542,12 @@ struct Child {
 
 Child spawn(const std::vector<std::string>& args, bool pipe_stdout) {
   int fds[2] = {-1, -1};
-  if (pipe_stdout && pipe(fds) != 0) throw std::runtime_error("pipe failed");
+  if (pipe_stdout && pipe(fds) != 0) throw SystemError("pipe failed");
   std::vector<char*> argv;
   for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
   argv.push_back(nullptr);
   const pid_t pid = fork();
-  if (pid < 0) throw std::runtime_error("fork failed");
+  if (pid < 0) throw SystemError("fork failed");
   if (pid == 0) {
     if (pipe_stdout) {
       dup2(fds[1], STDOUT_FILENO);
@@ -595,7 +595,7 @@ int wait_child(pid_t pid) {
 
 json read_json(const std::string& path) {
   std::ifstream f(path);
-  if (!f) throw std::runtime_error("cannot read " + path);
+  if (!f) throw SystemError("cannot read " + path);
   return json::parse(f);
 }
 
@@ -642,7 +642,7 @@ int run_run(const RunOptions& o) {
   if (!wait_ready(slave.stdout_fd, 10.0)) {
     kill(slave.pid, SIGTERM);
     wait_child(slave.pid);
-    throw std::runtime_error("the slave did not start (no 'ready' line within 10 s)");
+    throw RunError("the slave did not start (no 'ready' line within 10 s)");
   }
   std::vector<std::string> master_args{"lash", "hil", "master"};
   for (auto& a : common_args(o.common, config, s.bus, s.step_s * 1e3)) master_args.push_back(a);

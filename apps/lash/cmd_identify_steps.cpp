@@ -20,7 +20,7 @@ struct Options {
 };
 
 int run(const Options& o) {
-  const CsvTable tab = read_csv(o.data);
+  const Table tab = read_csv(o.data);
   const auto& t = tab[o.t_col];
   const auto& cur = tab[o.i_col];
   const auto& p = tab[o.p_col];

@@ -26,6 +26,7 @@ struct EstimateOptions {
   std::string out;
   std::string plot;
   bool json = false;
+  bool strict = false;  ///< a non-finite row is an error instead of skipped
   bool timing = false;
   std::string preset = "lash";
   bool preset_given = false;  // --preset on the command line (beats a `preset` key in --config)

@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "lash/identify/estimators.hpp"
+#include "lash/io/error.hpp"
 #include "lash/metrics/first_order.hpp"
 #include "lash/signals/rng.hpp"
 
@@ -74,7 +75,7 @@ FirstOrderDeadzoneModel identify_online_on_rig(const rigs::PilotValveRigParams& 
   }
   const SideParams p = est.params(Side::right);
   if (!p.identified || !(p.a1 < 0 && p.a1 > -1) || !(p.b1 > 0))
-    throw std::runtime_error("online estimator did not identify the right side");
+    throw RunError("online estimator did not identify the right side");
   FirstOrderDeadzoneModel m;
   m.gain_kPa_per_mA = static_gain(p.a1, p.b1);
   m.tau_s = time_constant_s(p.a1, dt_s);

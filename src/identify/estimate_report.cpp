@@ -5,6 +5,8 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include "lash/io/table.hpp"
+
 namespace lash {
 namespace {
 using Json = nlohmann::ordered_json;
@@ -65,12 +67,20 @@ std::string estimate_json(const EstimateReport& r, const ReportFit& fit) {
   j["nrmse"] = num(fit.nrmse);
   j["nrmse_pct"] = num(100.0 * fit.nrmse);
   j["nrmse_window_s"] = {fit.t0_s, fit.t1_s};
+  j["rows_skipped"] = fit.rows_skipped;
+  j["gaps"] = fit.gaps;
   return j.dump();
 }
 
 std::string estimate_text(const EstimateReport& r, double dt_s, const ReportFit& fit) {
   std::string out = fmt::format("model {}: {} samples at dt = {} s, {} skipped\n", to_string(r.model), r.samples,
                                 sig(dt_s), r.skipped);
+  if (fit.rows_skipped)
+    out += fmt::format("data: {} rows with a non-finite value skipped (the first at line {})\n", fit.rows_skipped,
+                       fit.first_skipped_line);
+  if (fit.gaps)
+    out += fmt::format("data: {} gaps in t (steps > {} x the median step {} s)\n", fit.gaps, sig(kGapFactor),
+                       sig(fit.median_dt_s));
   auto show = [&](const char* name, const SideReport& s) {
     std::string line = fmt::format("{:>6}: a1 = {}  b1 = {}", name, sig(s.params.a1), sig(s.params.b1));
     if (r.has_c) line += "  c = " + sig(s.params.c);

@@ -8,6 +8,7 @@
 #include <matio.h>
 
 #include "lash/io/csv.hpp"
+#include "lash/io/table.hpp"
 #include "lash/io/error.hpp"
 #include "lash/io/mat.hpp"
 
@@ -31,6 +32,18 @@ MatPtr open_mat(const std::filesystem::path& path) {
   return m;
 }
 
+/// The variables of an open file, comma-separated (for messages); rewinds the file.
+std::string variables_of(mat_t* mat) {
+  Mat_Rewind(mat);
+  std::string out;
+  while (matvar_t* v = Mat_VarReadNextInfo(mat)) {
+    VarPtr guard(v);
+    if (v->name) out += (out.empty() ? "" : ", ") + std::string(v->name);
+  }
+  Mat_Rewind(mat);
+  return out.empty() ? "no variables" : out;
+}
+
 template <class T>
 void convert(const void* data, std::size_t n, std::vector<double>& out) {
   const T* p = static_cast<const T*>(data);
@@ -39,13 +52,15 @@ void convert(const void* data, std::size_t n, std::vector<double>& out) {
 }
 
 /// Reads variable `name` as a flat vector of doubles; `elements` = its element count.
-std::vector<double> read_numeric(mat_t* mat, const std::string& file, const std::string& name, bool& is_scalar) {
+std::vector<double> read_numeric(mat_t* mat, const std::string& file, const std::string& name, bool& is_scalar,
+                                 std::size_t* matrix_cols = nullptr) {
   VarPtr var(Mat_VarRead(mat, name.c_str()));
-  if (!var) throw InputError(file, 0, name, "no variable named '" + name + "' in this MAT file");
+  if (!var) throw InputError(file, 0, name, "no variable named '" + name + "' in this MAT file (it holds: " + variables_of(mat) + ")");
   if (var->isComplex) throw InputError(file, 0, name, "is complex; a real numeric variable is needed");
   if (var->rank != 2) throw InputError(file, 0, name, "has " + std::to_string(var->rank) + " dimensions; a vector is needed");
   const std::size_t r = var->dims[0], c = var->dims[1];
-  if (r != 1 && c != 1)
+  if (matrix_cols) *matrix_cols = c;
+  if (r != 1 && c != 1 && !matrix_cols)
     throw InputError(file, 0, name,
                      "is a " + std::to_string(r) + "x" + std::to_string(c) + " matrix; a vector (Nx1 or 1xN) is needed");
   const std::size_t n = r * c;
@@ -150,11 +165,11 @@ std::vector<std::string> mat_variable_names(const std::filesystem::path& path) {
   return names;
 }
 
-CsvTable read_mat(const std::filesystem::path& path, const std::vector<std::string>& variables) {
+Table read_mat(const std::filesystem::path& path, const std::vector<std::string>& variables) {
   const std::string file = path.string();
   if (variables.empty()) throw InputError(file, 0, "", "no variables named to read");
   MatPtr mat = open_mat(path);
-  CsvTable t;
+  Table t;
   t.file = file;
   std::vector<bool> scalar(variables.size());
   std::size_t n = 0;
@@ -162,7 +177,7 @@ CsvTable read_mat(const std::filesystem::path& path, const std::vector<std::stri
   for (std::size_t i = 0; i < variables.size(); ++i) {
     bool s = false;
     t.cols.push_back(read_column(mat.get(), file, variables[i], s));
-    t.header.push_back(variables[i]);
+    t.names.push_back(variables[i]);
     scalar[i] = s;
     if (!s) {
       if (n == 0) {
@@ -180,6 +195,48 @@ CsvTable read_mat(const std::filesystem::path& path, const std::vector<std::stri
     if (scalar[i]) t.cols[i].assign(n, t.cols[i][0]);
   t.line_of_row.resize(n);
   for (std::size_t k = 0; k < n; ++k) t.line_of_row[k] = static_cast<int>(k + 1);
+  return t;
+}
+
+Table read_mat_table(const std::filesystem::path& path, const TableOptions& options) {
+  const std::string file = path.string();
+  const auto& cols = options.columns;
+  if (cols.empty()) throw InputError(file, 0, "--columns", "name the variables to read from a MAT file");
+  for (std::size_t i = 0; i < cols.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (cols[i] == cols[j]) throw InputError(file, 0, "--columns", "column '" + cols[i] + "' is chosen twice");
+  const bool indices = std::all_of(cols.begin(), cols.end(), [](const std::string& c) {
+    return !c.empty() && c.size() < 9 && c.find_first_not_of("0123456789") == std::string::npos;
+  });
+  if (!indices) return read_mat(path, cols);
+  MatPtr mat = open_mat(path);
+  std::vector<std::string> vars;
+  while (matvar_t* v = Mat_VarReadNextInfo(mat.get())) {
+    VarPtr guard(v);
+    if (v->name) vars.emplace_back(v->name);
+  }
+  for (const auto& c : cols)
+    if (std::find(vars.begin(), vars.end(), c) != vars.end()) return read_mat(path, cols);  // variables named "0"…
+  if (vars.size() != 1)
+    throw InputError(file, 0, "--columns",
+                     "column indices need a MAT file holding one N×k matrix; it holds: " + variables_of(mat.get()));
+  bool scalar = false;
+  std::size_t k = 0;
+  Mat_Rewind(mat.get());
+  const std::vector<double> m = read_numeric(mat.get(), file, vars[0], scalar, &k);
+  const std::size_t n = k ? m.size() / k : 0;
+  Table t;
+  t.file = file;
+  for (const auto& c : cols) {
+    const std::size_t j = std::stoul(c);
+    if (j >= k)
+      throw InputError(file, 0, c, "column index out of range ('" + vars[0] + "' is " + std::to_string(n) + "x" +
+                                       std::to_string(k) + ", columns 0.." + std::to_string(k - 1) + ")");
+    t.names.push_back(c);
+    t.cols.emplace_back(m.begin() + static_cast<std::ptrdiff_t>(j * n), m.begin() + static_cast<std::ptrdiff_t>((j + 1) * n));
+  }
+  t.line_of_row.resize(n);
+  for (std::size_t i = 0; i < n; ++i) t.line_of_row[i] = static_cast<int>(i + 1);
   return t;
 }
 

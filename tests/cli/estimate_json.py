@@ -36,6 +36,7 @@ with tempfile.TemporaryDirectory() as d:
     # every key of before keeps its name and order; the verdict, units and percentage are added
     check(in_order(j, ["model", "samples", "right", "left", "nrmse", "nrmse_window_s"]), f"keys {list(j)}")
     check(abs(j["nrmse_pct"] - 100 * j["nrmse"]) <= 1e-12 * max(1.0, j["nrmse_pct"]), "nrmse_pct = 100 nrmse")
+    check(j.get("rows_skipped") == 0 and j.get("gaps") == 0, "no rows skipped, no gaps")
     check(j["model"] == "deadzone-deadband" and j["samples"] == 40000, "model and samples")
     truth = {"right": dict(a1=-0.96, b1=0.1, c=200.0, d=30.0), "left": dict(a1=-0.94, b1=0.15, c=-300.0, d=50.0)}
     for side in ("right", "left"):

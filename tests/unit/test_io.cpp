@@ -8,6 +8,7 @@
 #include "lash/io/atomic_file.hpp"
 #include "lash/io/csv.hpp"
 #include "lash/io/error.hpp"
+#include "lash/io/table.hpp"
 #include "lash/plant/plant_file.hpp"
 
 using namespace lash;
@@ -61,6 +62,24 @@ TEST(Csv, ReadsAndNamesBadCells) {
   EXPECT_THROW(read_csv(tmpfile("empty.csv", "")), InputError);
   EXPECT_THROW(read_csv(tmpfile("nan.csv", "t\nnan\n")), InputError);
   for (auto p : {ok, bad, nonmono}) fs::remove(p);
+}
+
+TEST(Error, OneBaseForEveryErrorAPersonSees) {
+  // main's catch-all maps InputError to exit 2 and every other lash::Error to exit 1:
+  // the kinds must be told apart by type, and all be caught as lash::Error.
+  const InputError in("f.csv", 3, "v", "not a finite number");
+  const SystemError sys("fork failed");
+  const RunError run("the slave did not start");
+  const Error* all[] = {&in, &sys, &run};
+  for (const Error* e : all) EXPECT_NE(dynamic_cast<const std::runtime_error*>(e), nullptr);
+  EXPECT_EQ(dynamic_cast<const InputError*>(static_cast<const Error*>(&sys)), nullptr);
+  EXPECT_EQ(dynamic_cast<const InputError*>(static_cast<const Error*>(&run)), nullptr);
+  EXPECT_STREQ(in.what(), "f.csv:3: 'v': not a finite number");
+  try {
+    throw InputError("f.csv", 3, "v", "bad");
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "f.csv:3: 'v': bad");
+  }
 }
 
 TEST(AtomicFile, NothingLeftWithoutCommit) {
@@ -119,4 +138,111 @@ TEST(PlantFile, WidthMeansFullWidthAndKTauForm) {
   EXPECT_DOUBLE_EQ(g.params().right.a1, -std::exp(-0.1));
   EXPECT_EQ(std::get<Deadband>(plant.blocks()[1]).half_width().left, 10.0);
   fs::remove(p);
+}
+
+// ---- read_table: the user's files (issue 12 item 6) --------------------------------------
+
+namespace {
+// One record, t/v/y with a spare column, written by hand in each dialect.
+const std::vector<double> kT{0, 0.01, 0.02, 0.03}, kV{1.5, -2.25, 300, 4e-3}, kY{0.125, 7, -8.5, 9};
+}  // namespace
+
+TEST(Table, EveryDialectGivesTheSameColumns) {
+  const std::string dialects[] = {
+      "t,v,x,y\n0,1.5,9,0.125\n0.01,-2.25,9,7\n0.02,300,9,-8.5\n0.03,4e-3,9,9\n",
+      "t;v;x;y\n0;1,5;9;0,125\n0,01;-2,25;9;7\n0,02;300;9;-8,5\n0,03;4e-3;9;9\n",     // decimal comma
+      "t;v;x;y\r\n0;1.5;9;0.125\r\n0.01;-2.25;9;7\r\n0.02;300;9;-8.5\r\n0.03;0.004;9;9\r\n",
+      "t\tv\tx\ty\n0\t1.5\t9\t0.125\n0.01\t-2.25\t9\t7\n0.02\t300\t9\t-8.5\n0.03\t4e-3\t9\t9\n",
+      "\xEF\xBB\xBF" "t,v,x,y\n0,1.5,9,0.125\n0.01,-2.25,9,7\n0.02,300,9,-8.5\n0.03,4e-3,9,9\n",  // BOM
+      "# exported by a logger\n  t   v  x   y\n0 1.5 9 0.125\n\n0.01  -2.25 9 7\n# pause\n0.02 300 9 -8.5\n0.03 4e-3 9 9",
+      "\"t\",\"v\",\"x\",\"y\"\n0,1.5,9,0.125\n0.01,-2.25,9,+7\n0.02, 300 ,9,-8.5\n0.03,4e-3,9,9\n",
+  };
+  int k = 0;
+  for (const auto& text : dialects) {
+    const auto p = tmpfile("dialect" + std::to_string(k++) + ".csv", text);
+    TableOptions o;
+    o.columns = {"t", "v", "y"};
+    const Table t = read_table(p, o);
+    SCOPED_TRACE(text);
+    ASSERT_EQ(t.names, (std::vector<std::string>{"t", "v", "y"}));
+    EXPECT_EQ(t.cols[0], kT);
+    EXPECT_EQ(t.cols[1], kV);
+    EXPECT_EQ(t.cols[2], kY);
+    o.columns = {"0", "1", "3"};  // the same by 0-based index
+    const Table u = read_table(p, o);
+    EXPECT_EQ(u.cols, t.cols);
+    EXPECT_EQ(t.skipped_rows, 0u);
+    fs::remove(p);
+  }
+}
+
+TEST(Table, HeaderlessFileIsReadByIndex) {
+  const auto p = tmpfile("nohead.csv", "0 1.5 0.125\n0.01 -2.25 7\n0.02 300 -8.5\n0.03 4e-3 9\n");
+  TableOptions o;
+  o.columns = {"0", "1", "2"};
+  const Table t = read_table(p, o);
+  EXPECT_EQ(t.cols[0], kT);
+  EXPECT_EQ(t.cols[2], kY);
+  EXPECT_EQ(t.line_of_row.front(), 1);
+  fs::remove(p);
+}
+
+TEST(Table, ChoicesAreCheckedAndOnlyChosenCellsParsed) {
+  const auto p = tmpfile("choose.csv", "t,v,note,y\n0,1,abc,2\n0.1,2,def,3\n");
+  TableOptions o;
+  o.columns = {"t", "v", "y"};
+  EXPECT_EQ(read_table(p, o).rows(), 2u);  // the text column is never parsed
+  o.columns = {"t", "0", "y"};             // t twice (by name and by index)
+  try {
+    read_table(p, o);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "--columns");
+    EXPECT_NE(std::string(e.what()).find("chosen twice"), std::string::npos);
+  }
+  o.columns = {"t", "v", "7"};
+  EXPECT_THROW(read_table(p, o), InputError);
+  o.columns = {"t", "note", "y"};
+  try {
+    read_table(p, o);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.line(), 2);
+    EXPECT_EQ(e.field(), "note");
+  }
+  fs::remove(p);
+}
+
+TEST(Table, NonFiniteRowsAreSkippedAndCountedUnlessStrict) {
+  const auto p = tmpfile("nan.csv", "t,v,y\n0,1,2\n0.1,nan,3\n0.2,2,\n0.3,inf,1\n0.4,5,NaN\n0.5,6,7\n");
+  TableOptions o;
+  o.columns = {"t", "v", "y"};
+  const Table t = read_table(p, o);
+  EXPECT_EQ(t.skipped_rows, 4u);
+  EXPECT_EQ(t.first_skipped_line, 3);
+  EXPECT_EQ(t.cols[0], (std::vector<double>{0, 0.5}));
+  EXPECT_EQ(t.line_of_row, (std::vector<int>{2, 7}));
+  o.strict = true;
+  try {
+    read_table(p, o);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.line(), 3);
+    EXPECT_EQ(e.field(), "v");
+  }
+  fs::remove(p);
+}
+
+TEST(Table, GapsAreFoundAndNotAveragedIntoDt) {
+  // 0, 1, 2, 3, then a gap of 10 (> 5 × the median 1), then 14, 15: dt = (15 − 0 − 10)/(6 − 1) = 1.
+  const std::vector<double> t{0, 1, 2, 3, 13, 14, 15};
+  const Sampling s = analyse_sampling(t);
+  EXPECT_EQ(s.median_dt, 1.0);
+  EXPECT_EQ(s.gap_rows, (std::vector<std::size_t>{4}));
+  EXPECT_DOUBLE_EQ(s.dt, 1.0);
+  // Without a gap dt is exactly the span over the steps.
+  const std::vector<double> u{0, 0.1, 0.3, 0.4};
+  EXPECT_EQ(analyse_sampling(u).dt, 0.4 / 3);
+  EXPECT_TRUE(analyse_sampling(u).gap_rows.empty());
+  EXPECT_NEAR(analyse_sampling(u).max_jitter, 1.0, 1e-12);  // the 0.2 step against the median 0.1
 }

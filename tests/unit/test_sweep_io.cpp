@@ -50,9 +50,9 @@ TEST(MatReader, ReadsScipyV5AndV4) {
     const fs::path d = temp_dir();
     const fs::path f = d / (std::string("rec_v") + format + ".mat");
     if (!write_with_scipy(f, format)) GTEST_SKIP() << "SKIPPED: /usr/bin/python3 with scipy not available";
-    const lash::CsvTable t = lash::read_mat(f, {"t", "v", "k"});
+    const lash::Table t = lash::read_mat(f, {"t", "v", "k"});
     ASSERT_EQ(t.rows(), 5u);
-    EXPECT_EQ(t.header[1], "v");
+    EXPECT_EQ(t.names[1], "v");
     EXPECT_DOUBLE_EQ(t["t"][4], 2.0);
     EXPECT_DOUBLE_EQ(t["v"][2], 3.5);
     EXPECT_DOUBLE_EQ(t["k"][3], 2.5);  // a 1x1 variable is repeated on every row
@@ -77,7 +77,7 @@ TEST(MatReader, ColumnExpressions) {
   EXPECT_DOUBLE_EQ(t.cols[1][2], 11.0);
   EXPECT_DOUBLE_EQ(t.cols[1][4], 15.5);
   EXPECT_DOUBLE_EQ(t.cols[2][3], 7.5);
-  EXPECT_EQ(t.header[0], "k*v");
+  EXPECT_EQ(t.names[0], "k*v");
   fs::remove_all(d);
 }
 

@@ -39,7 +39,7 @@ ControllerConfig design_for_rise(const FirstOrderDeadzoneModel& m, double bias_k
 /// deadzone, `duration_s` long) drives the rig open loop while the input-deadzone RLS
 /// estimator (λ = 0.995, switching guess c_r* = `deadzone_guess_mA`) runs sample by sample.
 /// Returns K = b1/(1 + a1), τ = −T/ln(−a1), c = −e/b1 of the right side at the end.
-/// Throws std::runtime_error if the estimator has not identified the right side.
+/// Throws lash::RunError if the estimator has not identified the right side.
 FirstOrderDeadzoneModel identify_online_on_rig(const rigs::PilotValveRigParams& rig, double dt_s,
                                                std::uint64_t seed, double duration_s = 20.0,
                                                double deadzone_guess_mA = 350.0);

@@ -1,35 +1,38 @@
 #pragma once
 /// @file data.hpp
-/// Loading a measured record as named numeric columns, independent of the file format.
-/// A ".mat" file is read as MAT (io/mat.hpp), anything else as CSV (io/csv.hpp).
-/// Not real-time safe. Errors are lash::InputError naming file, line (where there is one) and column.
+/// Loading a measured record (t, v, y) for estimation from any file io::read_table reads
+/// (CSV and its cousins, MAT; io/table.hpp). Not real-time safe. Errors are lash::InputError
+/// naming file, line (where there is one) and column.
 #include <filesystem>
 #include <string>
 #include <vector>
 
+#include "lash/io/table.hpp"
+
 namespace lash {
 
-/// Columns in the order they were asked for, all of the same length.
-struct ColumnData {
-  std::string file;
-  std::vector<std::string> names;
-  std::vector<std::vector<double>> cols;
-  std::vector<int> line_of_row;  ///< 1-based source line of each row (empty when the format has no lines)
-  std::size_t rows() const noexcept { return cols.empty() ? 0 : cols[0].size(); }
-};
+/// The columns asked for, in that order (the table type of io/table.hpp).
+using ColumnData = Table;
 
-/// Reads exactly the columns `names` from `path` (MAT or CSV); InputError for a missing one.
-ColumnData load_columns(const std::filesystem::path& path, const std::vector<std::string>& names);
+/// Reads exactly the columns `names` (names or 0-based indices) from `path`; InputError for a
+/// missing one. Rows with a non-finite chosen cell are skipped and counted (ColumnData::
+/// skipped_rows) unless `strict`, which makes them an error.
+ColumnData load_columns(const std::filesystem::path& path, const std::vector<std::string>& names, bool strict = false);
 
-/// Loads t, v, y for estimation: `names` = {t, v, y} column names; checks that t is strictly
-/// increasing (InputError naming the line) and returns the sample period (mean step of t).
+/// A record for estimation: `names` = {t, v, y} columns. t must increase strictly (InputError
+/// naming the line). Sampling: dt_s is the mean step over the steps that are not gaps; a step
+/// longer than kGapFactor (io/table.hpp) median steps is a gap, listed in data.gap_rows (row i
+/// starts a new stretch: an estimator restarts its regressors there) — never averaged into dt.
 struct Record {
   ColumnData data;
-  double dt_s = 0.0;
+  double dt_s = 0.0;       ///< sample period [s]: mean step without the gaps
+  Sampling sampling;       ///< median step, jitter, gaps
   const std::vector<double>& t() const { return data.cols[0]; }
   const std::vector<double>& v() const { return data.cols[1]; }
   const std::vector<double>& y() const { return data.cols[2]; }
+  std::size_t skipped_rows() const noexcept { return data.skipped_rows; }
+  const std::vector<std::size_t>& gap_rows() const noexcept { return data.gap_rows; }
 };
-Record load_record(const std::filesystem::path& path, const std::vector<std::string>& names);
+Record load_record(const std::filesystem::path& path, const std::vector<std::string>& names, bool strict = false);
 
 }  // namespace lash

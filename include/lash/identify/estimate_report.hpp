@@ -19,6 +19,11 @@ namespace lash {
 struct ReportFit {
   double nrmse = std::numeric_limits<double>::quiet_NaN();
   double t0_s = 0.0, t1_s = 0.0;
+  // What the reader found in the record (io/table.hpp): reported as rows_skipped and gaps.
+  std::size_t rows_skipped = 0;  ///< rows dropped for a non-finite value
+  int first_skipped_line = 0;    ///< file line of the first of them
+  std::size_t gaps = 0;          ///< steps of t longer than kGapFactor median steps
+  double median_dt_s = 0.0;      ///< median step of t [s]
 };
 
 std::string estimate_json(const EstimateReport& r, const ReportFit& fit);

@@ -1,0 +1,72 @@
+#pragma once
+/// @file table.hpp
+/// One table type for every record lash reads, and one reader that picks the format:
+/// read_table(path) reads a MAT file (by its ".mat" extension or its "MATLAB" header) with
+/// io/mat.hpp, anything else as text (CSV and its cousins). Not real-time safe.
+///
+/// Text files (docs/data_files.md):
+/// - separator sniffed from the first non-comment line: tab if it holds one, else ';' if it
+///   holds one, else ',' if it holds one, else runs of spaces (whitespace-separated columns);
+/// - a UTF-8 byte-order mark is dropped; '\r\n' line ends are accepted;
+/// - lines whose first non-blank character is '#', and blank lines, are skipped;
+/// - decimal comma ("1,5") is read when the separator is not ',' (e.g. ';' files from a
+///   German spreadsheet);
+/// - the first line is the header unless every field of it is a number (then the columns are
+///   named "0", "1", …);
+/// - columns are chosen by header name or by 0-based index ("0", "2"); a column chosen twice
+///   is refused; only the chosen columns are parsed;
+/// - a row where a chosen cell is not finite ("nan", "inf", empty) is skipped and counted in
+///   Table::skipped_rows, or is an InputError naming file:line:column with `strict`;
+/// - any other text in a chosen cell is an InputError naming file:line:column.
+/// Ingest streams the file in 1 MiB blocks, parses with std::from_chars straight into the
+/// columns (reserved from the file size) and allocates nothing per row.
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace lash {
+
+/// Named numeric columns of one length, with where each row came from.
+struct Table {
+  std::string file;                       ///< where it came from (for messages)
+  std::vector<std::string> names;         ///< column names, in file order or in the order chosen
+  std::vector<std::vector<double>> cols;  ///< cols[c][row]
+  std::vector<int> line_of_row;           ///< 1-based file line of each row (MAT: element index)
+  std::size_t skipped_rows = 0;           ///< rows dropped for a non-finite chosen cell
+  int first_skipped_line = 0;             ///< line of the first such row (0: none)
+  std::vector<std::size_t> gap_rows;      ///< rows i where a gap ends (mark_gaps): t[i] − t[i−1] is a gap
+
+  std::size_t rows() const noexcept { return cols.empty() ? 0 : cols[0].size(); }
+  /// Index of column `name`, or throws InputError naming the file, header line and column.
+  std::size_t column(std::string_view name) const;
+  const std::vector<double>& operator[](std::string_view name) const { return cols[column(name)]; }
+};
+
+struct TableOptions {
+  /// Columns to read, by name or 0-based index, in the order wanted; empty = all (text) .
+  /// MAT: variable names or expressions (io/mat.hpp), or indices into a file's only N×k matrix.
+  std::vector<std::string> columns;
+  bool strict = false;  ///< a non-finite chosen cell is an error instead of a skipped row
+};
+
+/// Reads a record (MAT or text, see above). Throws InputError naming file, line and column.
+Table read_table(const std::filesystem::path& path, const TableOptions& options = {});
+
+/// A gap: a time step longer than this many median steps. The rows after a gap start a new
+/// stretch of data: estimators restart their regressors there (identify), and the sample
+/// period is the median step, so a gap is never averaged into dt.
+inline constexpr double kGapFactor = 5.0;
+
+/// Sampling of a strictly increasing time column.
+struct Sampling {
+  double median_dt = 0.0;              ///< median of t[i] − t[i−1]
+  double dt = 0.0;                     ///< mean step over the steps that are not gaps
+  double max_jitter = 0.0;             ///< max |step − median| / median over non-gap steps
+  std::vector<std::size_t> gap_rows;   ///< rows i with t[i] − t[i−1] > kGapFactor·median_dt
+};
+/// Sampling of `t` (at least 2 samples). Steps above gap_factor·median are gaps.
+Sampling analyse_sampling(const std::vector<double>& t, double gap_factor = kGapFactor);
+
+}  // namespace lash

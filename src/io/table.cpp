@@ -1,0 +1,340 @@
+// read_table: the one record reader (text or MAT) and the sampling analysis.
+#include "lash/io/table.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+
+#include "lash/io/csv.hpp"
+#include "lash/io/error.hpp"
+#include "lash/io/mat.hpp"
+
+namespace lash {
+
+std::size_t Table::column(std::string_view name) const {
+  for (std::size_t i = 0; i < names.size(); ++i)
+    if (names[i] == name) return i;
+  std::string have;
+  for (const auto& h : names) have += (have.empty() ? "" : ",") + h;
+  throw InputError(file, 1, std::string(name), "no such column (the header has: " + have + ")");
+}
+
+namespace {
+
+struct FileCloser {
+  void operator()(std::FILE* f) const noexcept { std::fclose(f); }
+};
+
+bool is_blank(char c) noexcept { return c == ' ' || c == '\t'; }
+
+/// Outcome of reading one cell.
+enum class Cell { number, non_finite, junk };
+
+/// Parses a cell; fast path: the whole field is a plain number. Slow path: surrounding
+/// blanks and quotes, a leading '+', a decimal comma (when allowed), nan/inf, empty.
+Cell parse_cell(const char* b, const char* e, bool decimal_comma, double& v) noexcept {
+  auto r = std::from_chars(b, e, v);
+  if (r.ptr == e && r.ec == std::errc()) return std::isfinite(v) ? Cell::number : Cell::non_finite;
+  while (b < e && (is_blank(*b) || *b == '"' || *b == '\r')) ++b;
+  while (e > b && (is_blank(e[-1]) || e[-1] == '"' || e[-1] == '\r')) --e;
+  if (b < e && *b == '+') ++b;
+  if (b == e) return Cell::non_finite;  // an empty cell: a missing value
+  char buf[64];
+  const std::size_t n = static_cast<std::size_t>(e - b);
+  if (n >= sizeof buf) return Cell::junk;
+  std::memcpy(buf, b, n);
+  if (decimal_comma)
+    for (std::size_t i = 0; i < n; ++i)
+      if (buf[i] == ',') buf[i] = '.';
+  r = std::from_chars(buf, buf + n, v);
+  if (r.ptr != buf + n || r.ec == std::errc::invalid_argument) {
+    // from_chars does not read "NaN"/"Inf" spelled with capitals the C way only; lower-case it.
+    std::string low(buf, n);
+    for (char& c : low) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (low == "nan" || low == "-nan" || low == "inf" || low == "-inf" || low == "infinity" || low == "-infinity" ||
+        low == "na" || low == "null")
+      return Cell::non_finite;
+    return Cell::junk;
+  }
+  if (r.ec == std::errc::result_out_of_range) return Cell::non_finite;
+  return std::isfinite(v) ? Cell::number : Cell::non_finite;
+}
+
+/// Splits a line into fields (views into it): the sniffed separator, or runs of blanks when 0.
+void split(std::string_view line, char sep, std::vector<std::string_view>& out) {
+  out.clear();
+  if (sep == 0) {
+    std::size_t i = 0;
+    while (i < line.size()) {
+      while (i < line.size() && is_blank(line[i])) ++i;
+      if (i == line.size()) break;
+      const std::size_t s = i;
+      while (i < line.size() && !is_blank(line[i])) ++i;
+      out.push_back(line.substr(s, i - s));
+    }
+    return;
+  }
+  std::size_t start = 0;
+  for (std::size_t i = 0; i <= line.size(); ++i)
+    if (i == line.size() || line[i] == sep) {
+      out.push_back(line.substr(start, i - start));
+      start = i + 1;
+    }
+}
+
+std::string trim_name(std::string_view s) {
+  while (!s.empty() && (is_blank(s.front()) || s.front() == '"')) s.remove_prefix(1);
+  while (!s.empty() && (is_blank(s.back()) || s.back() == '"' || s.back() == '\r')) s.remove_suffix(1);
+  return std::string(s);
+}
+
+bool is_index(const std::string& s) {
+  return !s.empty() && s.size() < 9 && std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
+}
+
+/// Resolves the chosen columns against the header: field index of each, refusing unknown
+/// names, indices out of range and a column chosen twice.
+std::vector<std::size_t> choose(const std::string& file, int header_line, const std::vector<std::string>& header,
+                                const std::vector<std::string>& wanted) {
+  std::vector<std::size_t> idx;
+  if (wanted.empty()) {
+    for (std::size_t i = 0; i < header.size(); ++i) idx.push_back(i);
+    return idx;
+  }
+  for (const auto& w : wanted) {
+    auto it = std::find(header.begin(), header.end(), w);
+    std::size_t i = 0;
+    if (it != header.end()) {
+      i = static_cast<std::size_t>(it - header.begin());
+    } else if (is_index(w)) {
+      i = std::stoul(w);
+      if (i >= header.size())
+        throw InputError(file, header_line, w,
+                         "column index out of range (the file has " + std::to_string(header.size()) +
+                             " columns, 0.." + std::to_string(header.size() - 1) + ")");
+    } else {
+      std::string have;
+      for (const auto& h : header) have += (have.empty() ? "" : ",") + h;
+      throw InputError(file, header_line, w, "no such column (the header has: " + have + ")");
+    }
+    if (std::find(idx.begin(), idx.end(), i) != idx.end())
+      throw InputError(file, 0, "--columns", "column '" + header[i] + "' (index " + std::to_string(i) +
+                                                 ") is chosen twice");
+    idx.push_back(i);
+  }
+  return idx;
+}
+
+/// The text reader. State across blocks: the header, the chosen fields, the columns.
+class TextReader {
+ public:
+  TextReader(std::string file, const TableOptions& o) : o_(o) { t_.file = std::move(file); }
+
+  Table read(const std::filesystem::path& path) {
+    std::unique_ptr<std::FILE, FileCloser> f(std::fopen(path.c_str(), "rb"));
+    if (!f) throw InputError(t_.file, 0, "", "cannot open file for reading");
+    std::error_code ec;
+    file_size_ = std::filesystem::file_size(path, ec);
+    if (ec) file_size_ = 0;
+    std::vector<char> buf(1 << 20);
+    std::size_t have = 0;
+    bool first_block = true;
+    for (;;) {
+      if (have == buf.size()) buf.resize(buf.size() * 2);  // a line longer than the buffer
+      const std::size_t got = std::fread(buf.data() + have, 1, buf.size() - have, f.get());
+      const bool eof = got < buf.size() - have;
+      have += got;
+      const char* p = buf.data();
+      const char* end = buf.data() + have;
+      if (first_block) {
+        first_block = false;
+        if (have >= 3 && std::memcmp(p, "\xEF\xBB\xBF", 3) == 0) p += 3;  // UTF-8 byte-order mark
+        bytes_first_block_ = have;
+        lines_first_block_ = static_cast<std::size_t>(std::count(p, end, '\n')) + 1;
+      }
+      for (;;) {
+        const char* nl = static_cast<const char*>(std::memchr(p, '\n', static_cast<std::size_t>(end - p)));
+        if (!nl) break;
+        line(p, nl);
+        p = nl + 1;
+      }
+      if (eof) {
+        if (p < end) line(p, end);
+        break;
+      }
+      have = static_cast<std::size_t>(end - p);
+      std::memmove(buf.data(), p, have);
+    }
+    if (!have_header_) throw InputError(t_.file, 0, "", "empty file (expected a header line and data rows)");
+    if (t_.rows() == 0)
+      throw InputError(t_.file, lineno_, "",
+                       t_.skipped_rows ? "no data rows with finite values (" + std::to_string(t_.skipped_rows) +
+                                             " rows skipped)"
+                                       : std::string("no data rows after the header"));
+    return std::move(t_);
+  }
+
+ private:
+  void line(const char* b, const char* e) {
+    ++lineno_;
+    if (e > b && e[-1] == '\r') --e;
+    const char* q = b;
+    while (q < e && is_blank(*q)) ++q;
+    if (q == e || *q == '#') return;
+    if (!have_header_) return header(std::string_view(b, static_cast<std::size_t>(e - b)));
+    row(b, e);
+  }
+
+  void header(std::string_view sv) {
+    sep_ = sv.find('\t') != std::string_view::npos   ? '\t'
+           : sv.find(';') != std::string_view::npos ? ';'
+           : sv.find(',') != std::string_view::npos ? ','
+                                                    : 0;
+    decimal_comma_ = sep_ != ',';
+    std::vector<std::string_view> fields;
+    split(sv, sep_, fields);
+    bool numeric = true;
+    for (auto fv : fields) {
+      double v;
+      if (parse_cell(fv.data(), fv.data() + fv.size(), decimal_comma_, v) != Cell::number) numeric = false;
+    }
+    std::vector<std::string> names;
+    for (std::size_t i = 0; i < fields.size(); ++i) {
+      if (numeric) {
+        names.push_back(std::to_string(i));
+        continue;
+      }
+      std::string n = trim_name(fields[i]);
+      if (n.empty()) throw InputError(t_.file, lineno_, "header", "empty column name");
+      names.push_back(std::move(n));
+    }
+    have_header_ = true;
+    nfields_ = names.size();
+    const auto idx = choose(t_.file, lineno_, names, o_.columns);
+    slot_of_field_.assign(nfields_, -1);
+    for (std::size_t s = 0; s < idx.size(); ++s) {
+      slot_of_field_[idx[s]] = static_cast<int>(s);
+      t_.names.push_back(names[idx[s]]);
+    }
+    last_field_ = *std::max_element(idx.begin(), idx.end());
+    t_.cols.resize(idx.size());
+    vals_.resize(idx.size());
+    // Reserve from the file size and the first block's line density: one allocation per column.
+    const double per_line = static_cast<double>(bytes_first_block_) / static_cast<double>(std::max<std::size_t>(1, lines_first_block_));
+    const auto rows_est = static_cast<std::size_t>(static_cast<double>(file_size_) / std::max(1.0, per_line) * 1.05) + 16;
+    for (auto& c : t_.cols) c.reserve(rows_est);
+    t_.line_of_row.reserve(rows_est);
+    if (numeric) row(sv.data(), sv.data() + sv.size());
+  }
+
+  void row(const char* b, const char* e) {
+    const char* p = b;
+    bool bad = false;
+    int bad_slot = -1;
+    for (std::size_t f = 0; f <= last_field_; ++f) {
+      const char* fe;
+      if (sep_ == 0) {
+        while (p < e && is_blank(*p)) ++p;
+        if (p == e) too_few(f);
+        fe = p;
+        while (fe < e && !is_blank(*fe)) ++fe;
+      } else {
+        fe = static_cast<const char*>(std::memchr(p, sep_, static_cast<std::size_t>(e - p)));
+        if (!fe) fe = e;
+      }
+      const int s = slot_of_field_[f];
+      if (s >= 0) {
+        double v;
+        switch (parse_cell(p, fe, decimal_comma_, v)) {
+          case Cell::number: vals_[static_cast<std::size_t>(s)] = v; break;
+          case Cell::non_finite:
+            if (!bad) bad_slot = s;
+            bad = true;
+            break;
+          case Cell::junk:
+            throw InputError(t_.file, lineno_, t_.names[static_cast<std::size_t>(s)],
+                             "not a number: '" + std::string(p, fe) + "'");
+        }
+      }
+      if (f < last_field_) {
+        if (sep_ != 0 && fe == e) too_few(f + 1);
+        p = sep_ == 0 ? fe : fe + 1;
+      }
+    }
+    if (bad) {
+      if (o_.strict)
+        throw InputError(t_.file, lineno_, t_.names[static_cast<std::size_t>(bad_slot)],
+                         "not a finite number (rows with nan, inf or empty cells are skipped without --strict)");
+      if (t_.skipped_rows++ == 0) t_.first_skipped_line = lineno_;
+      return;
+    }
+    for (std::size_t s = 0; s < vals_.size(); ++s) t_.cols[s].push_back(vals_[s]);
+    t_.line_of_row.push_back(lineno_);
+  }
+
+  [[noreturn]] void too_few(std::size_t found) const {
+    throw InputError(t_.file, lineno_, "",
+                     "expected " + std::to_string(nfields_) + " fields, found " + std::to_string(found));
+  }
+
+  const TableOptions& o_;
+  Table t_;
+  char sep_ = ',';
+  bool decimal_comma_ = false;
+  bool have_header_ = false;
+  int lineno_ = 0;
+  std::size_t nfields_ = 0, last_field_ = 0;
+  std::vector<int> slot_of_field_;
+  std::vector<double> vals_;
+  std::uintmax_t file_size_ = 0;
+  std::size_t bytes_first_block_ = 0, lines_first_block_ = 0;
+};
+
+bool looks_like_mat(const std::filesystem::path& path) {
+  if (is_mat_file(path)) return true;
+  std::unique_ptr<std::FILE, FileCloser> f(std::fopen(path.c_str(), "rb"));
+  char head[6] = {};
+  if (!f || std::fread(head, 1, sizeof head, f.get()) != sizeof head) return false;
+  return std::memcmp(head, "MATLAB", 6) == 0;  // v5 / v7.3 header text
+}
+
+}  // namespace
+
+Table read_table(const std::filesystem::path& path, const TableOptions& options) {
+  if (looks_like_mat(path)) return read_mat_table(path, options);
+  TextReader r(path.string(), options);
+  return r.read(path);
+}
+
+Sampling analyse_sampling(const std::vector<double>& t, double gap_factor) {
+  Sampling s;
+  if (t.size() < 2) return s;
+  std::vector<double> d(t.size() - 1);
+  for (std::size_t i = 1; i < t.size(); ++i) d[i - 1] = t[i] - t[i - 1];
+  std::vector<double> sorted = d;
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+  double med = sorted[sorted.size() / 2];
+  if (sorted.size() % 2 == 0) {
+    const double lo = *std::max_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2));
+    med = 0.5 * (med + lo);
+  }
+  s.median_dt = med;
+  // dt = (span − the gap steps) / (steps − gaps): without gaps exactly (t.back() − t.front())/(n − 1).
+  double gap_sum = 0.0;
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    if (d[i] > gap_factor * med) {
+      s.gap_rows.push_back(i + 1);
+      gap_sum += d[i];
+      continue;
+    }
+    if (med > 0) s.max_jitter = std::max(s.max_jitter, std::abs(d[i] - med) / med);
+  }
+  const std::size_t n = d.size() - s.gap_rows.size();
+  s.dt = n ? (t.back() - t.front() - gap_sum) / static_cast<double>(n) : med;
+  return s;
+}
+
+}  // namespace lash
