@@ -62,7 +62,7 @@ def cpp_ns_per_sample(lash_bench, name):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--lash-bench", default=os.path.join(SRC, "build", "bin", "lash_bench"))
-    ap.add_argument("--fleet-records", type=int, default=40)
+    ap.add_argument("--fleet-records", type=int, default=80)
     ap.add_argument("--fleet-duration", type=float, default=200.0, help="record length [s]")
     ap.add_argument("--no-fleet", action="store_true", help="skip the fleet speed-up")
     args = ap.parse_args()

@@ -2,17 +2,29 @@
 
 #include <unistd.h>
 
+#include <sys/wait.h>
+
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
 #include <fmt/core.h>
 
+#include "lash/io/atomic_file.hpp"
 #include "lash/io/error.hpp"
 
 namespace lash::cli {
 
 void run_gnuplot(const std::string& script_in, const std::string& png_path) {
+  const std::filesystem::path dir =
+      std::filesystem::path(png_path).has_parent_path() ? std::filesystem::path(png_path).parent_path() : ".";
+  std::error_code dec;
+  if (!std::filesystem::is_directory(dir, dec))
+    throw InputError(png_path, 0, "--plot", "cannot write: directory " + dir.string() + " does not exist");
+  if (::access(dir.c_str(), W_OK) != 0)
+    throw InputError(png_path, 0, "--plot", "cannot write in directory " + dir.string() + ": " + std::strerror(errno));
   const std::string tmp_png = png_path + ".tmp." + std::to_string(::getpid()) + ".png";
   std::string script = script_in;
   for (auto pos = script.find("<OUTPUT>"); pos != std::string::npos; pos = script.find("<OUTPUT>"))
@@ -21,6 +33,8 @@ void run_gnuplot(const std::string& script_in, const std::string& png_path) {
   {
     std::ofstream f(gp);
     f << script;
+    f.flush();
+    if (!f) throw InputError(png_path, 0, "--plot", "cannot write the gnuplot script " + gp + ": " + std::strerror(errno));
   }
   const std::string cmd = "gnuplot '" + gp + "' 2>&1";
   FILE* p = ::popen(cmd.c_str(), "r");
@@ -35,7 +49,9 @@ void run_gnuplot(const std::string& script_in, const std::string& png_path) {
   std::filesystem::remove(gp, ec);
   if (status != 0 || !std::filesystem::exists(tmp_png)) {
     std::filesystem::remove(tmp_png, ec);
-    throw InputError(png_path, 0, "--plot", "gnuplot failed (is gnuplot-nox installed?): " + out);
+    if (status != -1 && WIFEXITED(status) && WEXITSTATUS(status) == 127)
+      throw InputError(png_path, 0, "--plot", "gnuplot not found on PATH (install gnuplot-nox): " + out);
+    throw InputError(png_path, 0, "--plot", "gnuplot failed: " + out);
   }
   std::filesystem::rename(tmp_png, png_path, ec);
   if (ec) throw InputError(png_path, 0, "--plot", "cannot write: " + ec.message());
@@ -43,6 +59,8 @@ void run_gnuplot(const std::string& script_in, const std::string& png_path) {
 
 void plot_csv(const std::string& csv_path, const std::string& png_path, const std::string& title,
               const std::vector<PlotPanel>& panels, const std::vector<PlotSeries>& series) {
+  if (is_stream_output(csv_path))
+    throw InputError(png_path, 0, "--plot", "needs -o to name a regular file (the plot reads it back), not " + csv_path);
   const int n = static_cast<int>(panels.size());
   std::string s;
   s += fmt::format("set terminal pngcairo noenhanced size 1200,{} font 'sans,10'\n", 300 * n + 60);

@@ -13,6 +13,8 @@ import csv as _csv
 import io as _io
 
 from ._lash import (  # noqa: F401  (re-exported)
+    BacklashInverse,
+    DeadzoneInverse,
     Estimator,
     InputError,
     Plant,
@@ -24,7 +26,7 @@ from ._lash import (  # noqa: F401  (re-exported)
 from ._lash import _sweep_csv
 from . import can  # noqa: F401
 
-__all__ = ["Estimator", "InputError", "Plant", "Result", "estimate", "read_record", "signal", "sweep", "can"]
+__all__ = ["BacklashInverse", "DeadzoneInverse", "Estimator", "InputError", "Plant", "Result", "estimate", "read_record", "signal", "sweep", "can"]
 __version__ = "0.1.0"
 
 InputError.__doc__ = (

@@ -1,4 +1,5 @@
-from ._lash import (Estimator as Estimator, InputError as InputError, Plant as Plant, Result as Result,
+from ._lash import (BacklashInverse as BacklashInverse, DeadzoneInverse as DeadzoneInverse,
+                    Estimator as Estimator, InputError as InputError, Plant as Plant, Result as Result,
                     estimate as estimate, read_record as read_record, signal as signal)
 from . import can as can
 

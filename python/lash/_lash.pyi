@@ -93,4 +93,39 @@ def signal(kind: str, duration_s: float, dt_s: float, *, amplitude: float = 1.0,
 def read_record(path: str, columns: Sequence[str] = ("t", "v", "y")) -> dict[str, Any]:
     """t [s], v, y arrays, dt_s [s] and file of a CSV or MAT record."""
 
+class DeadzoneInverse:
+    """Deadzone inverse (docs/compensation.md): u [output unit] -> v [input unit] with DZ(DI(u)) = u.
+    right, left: deadzone edges c_r, |c_l| >= 0 [input unit]; slopes > 0 [output unit / input unit];
+    smoothing: band delta >= 0 around u = 0 [output unit] (0 = exact inverse)."""
+    def __init__(self, right: float, left: float, *, slope_right: float = 1.0, slope_left: float = 1.0,
+                 smoothing: float = 0.0) -> None: ...
+    def step(self, u: float) -> float:
+        """One sample: desired deadzone output u [output unit] -> command v [input unit]."""
+    def apply(self, u: ArrayLike) -> npt.NDArray[np.float64]:
+        """step() on every sample of a 1-D array (GIL released)."""
+    def set_params(self, *, right: float = ..., left: float = ..., slope_right: float = ..., slope_left: float = ...,
+                   smoothing: float = ...) -> None:
+        """Replaces the given parameters between samples (units as in the constructor)."""
+    @property
+    def params(self) -> dict[str, float]: ...
+
+class BacklashInverse:
+    """Backlash inverse (docs/compensation.md): desired output u -> backlash input w [unit of w],
+    B(BI(u)) = u. right, left: gaps >= 0 while pushed up / down [unit of w] (deadband half-width d);
+    smoothing: travel of u over which the gap is crossed [unit of u] (0 = jump)."""
+    def __init__(self, right: float, left: float, *, smoothing: float = 0.0) -> None: ...
+    def step(self, u: float) -> float:
+        """One sample u(k) -> w(k) [unit of w]."""
+    def apply(self, u: ArrayLike) -> npt.NDArray[np.float64]:
+        """step() on every sample of a 1-D array, continuing from the current state (GIL released)."""
+    def reset(self, u0: float = 0.0, rising: bool = True) -> None:
+        """From rest at output u0, engaged rising (w = u0 + right) or falling (w = u0 - left)."""
+    def set_params(self, *, right: float = ..., left: float = ..., smoothing: float = ...) -> None:
+        """Replaces the given widths between samples [unit of w]; smoothing [unit of u]."""
+    @property
+    def offset(self) -> float:
+        """Current offset w - u [unit of w]."""
+    @property
+    def params(self) -> dict[str, float]: ...
+
 def _sweep_csv(campaign_path: str, jobs: int = 0) -> str: ...

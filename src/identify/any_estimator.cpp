@@ -99,7 +99,7 @@ EstimateReport AnyEstimator::report() const {
 }
 
 EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> v, std::span<const double> y,
-                            bool keep_trace) {
+                            bool keep_trace, const std::function<void(const AnyEstimator&)>& at_end) {
   if (v.size() != y.size()) throw std::invalid_argument("v and y differ in length");
   AnyEstimator est(cfg);
   EstimationRun run;
@@ -118,6 +118,7 @@ EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> 
     }
   }
   run.report = est.report();
+  if (at_end) at_end(est);
   return run;
 }
 

@@ -246,24 +246,27 @@ void tune_to_data(EstimatorConfig& c, const DataTraits& d) {
 AutoRun estimate_auto(const EstimatorConfig& cfg0, std::span<const double> v, std::span<const double> y_raw,
                       bool keep_trace, double gate) {
   AutoRun out;
-  std::vector<double> yc(y_raw.begin(), y_raw.end());
-  OutlierGateConfig gc;
-  gc.gate = gate;
-  OutlierGate gate_y(gc);
   // The gate is causal (usable online); over a whole record the sample after a flagged one is also
   // known: when it lies nearer the flagged value than the last accepted one, the output really
-  // stepped there (a square-wave input) and the sample is restored.
+  // stepped there (a square-wave input) and the sample is restored. gate 0 = off: y is used as is.
+  std::vector<double> yc;
   std::uint64_t flagged = 0;
-  for (std::size_t k = 0; k < yc.size(); ++k) {
-    const std::uint64_t before = gate_y.rejected();
-    yc[k] = gate_y.step(y_raw[k]);
-    if (gate_y.rejected() == before) continue;
-    const double next = k + 1 < yc.size() ? y_raw[k + 1] : yc[k];
-    if (std::fabs(next - y_raw[k]) < std::fabs(next - yc[k])) yc[k] = y_raw[k];
-    else ++flagged;
+  if (gate > 0.0) {
+    yc.assign(y_raw.begin(), y_raw.end());
+    OutlierGateConfig gc;
+    gc.gate = gate;
+    OutlierGate gate_y(gc);
+    for (std::size_t k = 0; k < yc.size(); ++k) {
+      const std::uint64_t before = gate_y.rejected();
+      yc[k] = gate_y.step(y_raw[k]);
+      if (gate_y.rejected() == before) continue;
+      const double next = k + 1 < yc.size() ? y_raw[k + 1] : yc[k];
+      if (std::fabs(next - y_raw[k]) < std::fabs(next - yc[k])) yc[k] = y_raw[k];
+      else ++flagged;
+    }
   }
   out.outliers = flagged;
-  const std::span<const double> y(yc);
+  const std::span<const double> y = gate > 0.0 ? std::span<const double>(yc) : y_raw;
   out.cfg = cfg0;
   EstimatorConfig& cfg = out.cfg;
   const bool search_r = uses_guesses(cfg.model) && std::isinf(cfg.guess_right);
@@ -273,16 +276,17 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, std::span<const double> v, st
     if (search_r) cfg.guess_right = g[0];
     if (search_l) cfg.guess_left = g[1];
   }
-  out.run = run_estimator(cfg, v, y, keep_trace);
+  // The edges each side's regression points at are read from the same run's final state (no second pass).
+  out.run = run_estimator(cfg, v, y, keep_trace, [&](const AnyEstimator& est) {
+    if (!uses_guesses(cfg.model)) return;
+    out.right.edge = raw_edge(est, Side::right);
+    out.left.edge = raw_edge(est, Side::left);
+  });
   if (uses_guesses(cfg.model)) {
     out.right.guess = cfg.guess_right;
     out.left.guess = cfg.guess_left;
     out.right.source = search_r ? GuessSource::searched : GuessSource::given;
     out.left.source = search_l ? GuessSource::searched : GuessSource::given;
-    AnyEstimator est(cfg);
-    for (std::size_t k = 0; k < v.size(); ++k) est.step(v[k], y[k]);
-    out.right.edge = raw_edge(est, Side::right);
-    out.left.edge = raw_edge(est, Side::left);
     out.right.wrong_side = std::isfinite(out.right.edge) && out.right.edge >= cfg.guess_right;
     out.left.wrong_side = std::isfinite(out.left.edge) && out.left.edge <= cfg.guess_left;
   }

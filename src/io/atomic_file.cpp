@@ -2,21 +2,59 @@
 
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstring>
+#include <iostream>
 #include <system_error>
 
 #include "lash/io/error.hpp"
 
 namespace lash {
 
+bool is_stream_output(const std::filesystem::path& path) {
+  if (path == "-") return true;
+  std::error_code ec;
+  const auto st = std::filesystem::status(path, ec);  // follows symlinks
+  return !ec && std::filesystem::exists(st) && !std::filesystem::is_regular_file(st);
+}
+
+namespace {
+
+std::string open_failure_reason(const std::filesystem::path& target, const std::filesystem::path& opened) {
+  const int err = errno;
+  std::string why = err ? std::strerror(err) : "unknown error";
+  const auto dir = target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) return "cannot open for writing: directory " + dir.string() + " does not exist";
+  if (opened != target) return "cannot open for writing (" + opened.string() + "): " + why;
+  return "cannot open for writing: " + why;
+}
+
+}  // namespace
+
 AtomicFile::AtomicFile(std::filesystem::path target) : target_(std::move(target)) {
-  tmp_ = target_;
-  tmp_ += ".tmp." + std::to_string(::getpid());
-  out_.open(tmp_, std::ios::out | std::ios::trunc | std::ios::binary);
-  if (!out_) throw InputError(target_.string(), 0, "", "cannot open for writing");
+  if (target_ == "-") {
+    direct_ = true;
+    tmp_ = target_;
+    os_ = &std::cout;
+    return;
+  }
+  if (is_stream_output(target_)) {
+    direct_ = true;
+    tmp_ = target_;
+    errno = 0;
+    out_.open(tmp_, std::ios::out | std::ios::binary);
+  } else {
+    tmp_ = target_;
+    tmp_ += ".tmp." + std::to_string(::getpid());
+    errno = 0;
+    out_.open(tmp_, std::ios::out | std::ios::trunc | std::ios::binary);
+  }
+  if (!out_) throw InputError(target_.string(), 0, "", open_failure_reason(target_, tmp_));
 }
 
 AtomicFile::~AtomicFile() {
-  if (!committed_) {
+  if (!committed_ && !direct_) {
     out_.close();
     std::error_code ec;
     std::filesystem::remove(tmp_, ec);
@@ -24,13 +62,15 @@ AtomicFile::~AtomicFile() {
 }
 
 void AtomicFile::commit() {
-  out_.flush();
-  const bool ok = static_cast<bool>(out_);
-  out_.close();
+  os_->flush();
+  const bool ok = static_cast<bool>(*os_);
+  if (os_ == &out_) out_.close();
   if (!ok) throw InputError(target_.string(), 0, "", "write failed");
-  std::error_code ec;
-  std::filesystem::rename(tmp_, target_, ec);
-  if (ec) throw InputError(target_.string(), 0, "", "cannot rename temporary file: " + ec.message());
+  if (!direct_) {
+    std::error_code ec;
+    std::filesystem::rename(tmp_, target_, ec);
+    if (ec) throw InputError(target_.string(), 0, "", "cannot rename temporary file: " + ec.message());
+  }
   committed_ = true;
 }
 

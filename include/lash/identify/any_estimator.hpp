@@ -2,6 +2,7 @@
 /// @file any_estimator.hpp
 /// One type for every estimator of SPEC A4 (a std::variant, no virtual calls), plus a
 /// summary report and a batch runner used by `lash estimate`, `lash demo` and sweeps.
+#include <functional>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -104,8 +105,11 @@ struct EstimationRun {
 };
 
 /// Steps `cfg`'s estimator through v, y (same length). keep_trace stores the parameters per step.
+/// `at_end`, when given, is called with the estimator after the last sample (to read more of its
+/// final state without a second pass over the record).
 EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> v, std::span<const double> y,
-                            bool keep_trace = false);
+                            bool keep_trace = false,
+                            const std::function<void(const AnyEstimator&)>& at_end = {});
 /// Adds the 95 % intervals of every identified side's parameters to run.report (batch means,
 /// intervals.hpp: runs the estimator once more over sections of the same record).
 void add_intervals(EstimationRun& run, const EstimatorConfig& cfg, std::span<const double> v,

@@ -1,33 +1,52 @@
 #pragma once
 /// @file atomic_file.hpp
-/// Output files that appear whole or not at all: data go to a temporary file
-/// next to the target, which is renamed over it only by `commit()`. If the
-/// object is destroyed without commit (an error was thrown), the temporary is
-/// removed and nothing half-written is left behind. Not real-time safe.
+/// Output files that appear whole or not at all. For a regular file (or a
+/// name that does not exist yet) data go to a temporary file next to the
+/// target, which is renamed over it only by `commit()`; if the object is
+/// destroyed without commit (an error was thrown), the temporary is removed
+/// and nothing half-written is left behind.
+///
+/// A target that exists and is not a regular file (`/dev/null`, a FIFO, a
+/// terminal) is opened and written directly — never renamed over — and the
+/// name `-` means standard output. Those outputs are streams, so "whole or
+/// nothing" cannot hold for them. Not real-time safe.
 #include <filesystem>
 #include <fstream>
+#include <ostream>
 
 namespace lash {
 
 class AtomicFile {
  public:
-  /// Opens `<target>.tmp.<pid>` for writing; throws InputError if it cannot.
+  /// Opens the temporary `<target>.tmp.<pid>` (regular file), the target
+  /// itself (existing non-regular file) or stdout (`-`); throws InputError
+  /// naming the target and the system's reason if it cannot.
   explicit AtomicFile(std::filesystem::path target);
   AtomicFile(const AtomicFile&) = delete;
   AtomicFile& operator=(const AtomicFile&) = delete;
   ~AtomicFile();
 
-  std::ofstream& stream() noexcept { return out_; }
+  std::ostream& stream() noexcept { return *os_; }
+  /// True when the target is written in place (stdout, device, FIFO).
+  bool direct() const noexcept { return direct_; }
+  /// The file being written: the temporary, or the target itself when direct().
   const std::filesystem::path& temp_path() const noexcept { return tmp_; }
   const std::filesystem::path& target() const noexcept { return target_; }
-  /// Flushes, closes and renames over the target; throws InputError on I/O failure.
+  /// Flushes, closes and (regular file) renames over the target; throws
+  /// InputError on I/O failure.
   void commit();
 
  private:
   std::filesystem::path target_;
   std::filesystem::path tmp_;
   std::ofstream out_;
+  std::ostream* os_ = &out_;
+  bool direct_ = false;
   bool committed_ = false;
 };
+
+/// True if `path` names standard output (`-`) or an existing file that is not
+/// a regular file (device, FIFO, socket): outputs that must be written in place.
+bool is_stream_output(const std::filesystem::path& path);
 
 }  // namespace lash
