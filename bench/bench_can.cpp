@@ -55,7 +55,7 @@ void encode_decode(benchmark::State& state, lash::can::dbc::ByteOrder order) {
     codec.decode(data, out);
     benchmark::DoNotOptimize(out.data());
     benchmark::ClobberMemory();
-    in[0] += 0.1;  // a new value each round
+    in[0] = in[0] < 6000.0 ? in[0] + 0.1 : 0.0;  // a new value each round, inside the 16-bit field
   }
   if (out[1] != 987.6 && out[1] != 987.6000000000001) state.SkipWithError("decode mismatch");
 }
@@ -89,7 +89,7 @@ void BM_CanHandWritten4Intel(benchmark::State& state) {
     out[3] = static_cast<double>((r >> 44) & 0xF);
     benchmark::DoNotOptimize(out.data());
     benchmark::ClobberMemory();
-    in[0] += 0.1;
+    in[0] = in[0] < 6000.0 ? in[0] + 0.1 : 0.0;
   }
   if (out[1] != 987.6 && out[1] != 987.6000000000001) state.SkipWithError("decode mismatch");
 }

@@ -271,16 +271,20 @@ MessageCodec::MessageCodec(const dbc::Message& message) : message_(message) {
     l.offset = c.offset_;
     l.min_phys = c.has_range_ ? c.min_phys_ : -std::numeric_limits<double>::infinity();
     l.max_phys = c.has_range_ ? c.max_phys_ : std::numeric_limits<double>::infinity();
-    l.raw_lo = c.raw_lo_;
-    l.raw_hi_excl = c.raw_hi_excl_;
-    l.raw_min_bits = c.signed_ ? (c.mask_ >> 1) + 1 : 0;  // most negative / 0
-    l.raw_max_bits = c.signed_ ? c.mask_ >> 1 : c.mask_;
+    l.raw_lo = c.signed_ ? -static_cast<std::int64_t>(c.mask_ >> 1) - 1 : 0;
+    l.raw_span = c.mask_;
+    // Largest |raw| of the field + 1, times 2^-50 (> 3·2^-53, the relative gap between the
+    // product and the quotient): fields over ~48 bits get half_tol ≤ 0 and always take
+    // the reference path, which stays exact.
+    l.half_tol = 0.5 - (std::ldexp(1.0, static_cast<int>(c.signed_ ? c.length_ - 1 : c.length_)) + 1.0) * std::ldexp(1.0, -50);
+    l.sign = c.signed_ ? (c.mask_ >> 1) + 1 : 0;
     l.index = static_cast<std::uint32_t>(i);
     l.lo = static_cast<std::uint8_t>(c.lo_base_);  // window at byte 0
-    l.sext = static_cast<std::uint8_t>(c.signed_ ? 64 - c.length_ : 0);
     l.word = sg.byte_order == dbc::ByteOrder::motorola ? 1 : 0;
     lanes_.push_back(l);
   }
+  std::stable_partition(lanes_.begin(), lanes_.end(), [](const Lane& l) { return l.word == 0; });
+  intel_lanes_ = static_cast<std::uint32_t>(std::count_if(lanes_.begin(), lanes_.end(), [](const Lane& l) { return l.word == 0; }));
   if (packed_)
     for (std::size_t i = 0; i < codecs_.size(); ++i) {
       const SignalCodec& c = codecs_[i];
@@ -322,10 +326,14 @@ bool MessageCodec::decode(std::span<const std::uint8_t> data, std::span<double> 
   if (packed_) {
     const std::uint64_t le = load_le(data, message_.size);
     const std::uint64_t words[2] = {le, __builtin_bswap64(le)};  // [word]
-    for (const Lane& l : lanes_) {
-      const std::uint64_t raw = (words[l.word] >> l.lo) & l.mask;
-      values[l.index] = static_cast<double>(static_cast<std::int64_t>(raw << l.sext) >> l.sext) * l.factor + l.offset;
-    }
+    const Lane* const lanes = lanes_.data();
+    const std::uint32_t n = static_cast<std::uint32_t>(lanes_.size());
+    const auto lane = [&](const Lane& l, std::uint64_t word) {
+      const std::uint64_t raw = (word >> l.lo) & l.mask;
+      values[l.index] = static_cast<double>(static_cast<std::int64_t>((raw ^ l.sign) - l.sign)) * l.factor + l.offset;
+    };
+    for (std::uint32_t k = 0; k < intel_lanes_; ++k) lane(lanes[k], words[0]);
+    for (std::uint32_t k = intel_lanes_; k < n; ++k) lane(lanes[k], words[1]);
     for (const std::uint32_t i : slow_) {
       const SignalCodec& c = codecs_[i];
       values[i] = c.to_physical((words[c.signal_.byte_order == dbc::ByteOrder::motorola ? 1 : 0] >> c.lo_base_) & c.mask_);
@@ -339,46 +347,58 @@ bool MessageCodec::decode(std::span<const std::uint8_t> data, std::span<double> 
   return true;
 }
 
+inline std::uint64_t MessageCodec::lane_raw(const Lane& l, double p, std::uint32_t& clamped) const noexcept {
+  // Fast path: p inside [min|max] (±inf without a DBC range), the product rounds like the
+  // exact quotient, the result fits the field. Anything else (NaN, ±inf, a value to clamp,
+  // a product within rounding error of a .5 tie) is decided by the reference to_raw().
+  if (!(p < l.min_phys) && !(p > l.max_phys)) [[likely]] {
+    const double q = (p - l.offset) * l.inv_factor;
+    // Round half to even without libm: adding and subtracting 2^52 with q's sign leaves
+    // the nearest integer (the FPU rounds ties to even).
+    const double m = std::copysign(4503599627370496.0, q);
+    const double r = (q + m) - m;
+    // |q·(1/f) − q/f| ≤ 3·2^-53·|q|; for |q| ≤ (largest raw + 1) half_tol keeps that gap
+    // away from a tie (see the constructor); a larger |q| leaves the field and takes the
+    // reference path below. NaN fails this test.
+    if (std::fabs(q - r) < l.half_tol) [[likely]] {
+      const auto ir = static_cast<std::int64_t>(r);  // |r| ≤ 2^52 here
+      if (static_cast<std::uint64_t>(ir) - static_cast<std::uint64_t>(l.raw_lo) <= l.raw_span) [[likely]]
+        return static_cast<std::uint64_t>(ir) & l.mask;
+    }
+  }
+  bool cl = false;
+  const std::uint64_t raw = codecs_[l.index].to_raw(p, cl);
+  clamped += cl ? 1u : 0u;
+  return raw;
+}
+
 template <bool Mux>
 std::uint32_t MessageCodec::encode_packed(std::span<const double> values, std::uint64_t set[2], std::uint64_t clear[2]) noexcept {
   std::uint32_t clamped = 0;
-  for (const Lane& l : lanes_) {
+  const Lane* const lanes = lanes_.data();
+  const std::uint32_t n = static_cast<std::uint32_t>(lanes_.size());
+  // Intel lanes, then Motorola lanes, each into a register accumulator.
+  std::uint64_t s0 = 0, s1 = 0, c0 = 0, c1 = 0;
+  for (std::uint32_t k = 0; k < intel_lanes_; ++k) {
+    const Lane& l = lanes[k];
     if constexpr (Mux) {
       if (!present_[l.index]) continue;
-      clear[l.word] |= l.mask << l.lo;
+      c0 |= l.mask << l.lo;
     }
-    const double p = values[l.index];
-    std::uint64_t raw;
-    if (p != p) [[unlikely]] {  // NaN
-      raw = 0;
-      ++clamped;
-    } else {
-      const double pc = std::min(std::max(p, l.min_phys), l.max_phys);  // ±inf without a DBC range
-      std::uint32_t c = pc != p ? 1u : 0u;
-      // Multiply by 1/factor; where that could round differently from the exact quotient
-      // (within ~1e-12 relative of a .5 tie, or beyond 2^51) divide instead, so the result
-      // is always round_half_even((p - offset) / factor).
-      const double q = (pc - l.offset) * l.inv_factor;
-      // Branch-free round half to even for |q| < 2^52: adding and subtracting 2^52 with
-      // q's sign leaves the nearest integer (the FPU rounds ties to even).
-      const double m = std::copysign(4503599627370496.0, q);
-      double r = (q + m) - m;
-      const double aq = std::fabs(q);
-      if (aq >= 2251799813685248.0 || std::fabs(q - r) >= 0.5 - (aq + 1.0) * 1e-12) [[unlikely]]
-        r = round_half_even((pc - l.offset) / l.factor);
-      if (r < l.raw_lo) [[unlikely]] {
-        raw = l.raw_min_bits;
-        c = 1;
-      } else if (r >= l.raw_hi_excl) [[unlikely]] {
-        raw = l.raw_max_bits;
-        c = 1;
-      } else {
-        raw = static_cast<std::uint64_t>(static_cast<std::int64_t>(r)) & l.mask;
-      }
-      clamped += c;
-    }
-    set[l.word] |= raw << l.lo;
+    s0 |= lane_raw(l, values[l.index], clamped) << l.lo;
   }
+  for (std::uint32_t k = intel_lanes_; k < n; ++k) {
+    const Lane& l = lanes[k];
+    if constexpr (Mux) {
+      if (!present_[l.index]) continue;
+      c1 |= l.mask << l.lo;
+    }
+    s1 |= lane_raw(l, values[l.index], clamped) << l.lo;
+  }
+  set[0] |= s0;
+  set[1] |= s1;
+  clear[0] |= c0;
+  clear[1] |= c1;
   for (const std::uint32_t i : slow_) {
     if (Mux && !present_[i]) continue;
     const SignalCodec& c = codecs_[i];

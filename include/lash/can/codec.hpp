@@ -151,22 +151,32 @@ class MessageCodec {
  private:
   /// Per-signal plan of the one-word path for messages of at most 8 bytes, built at
   /// construction: the payload is loaded once as a little- and a big-endian 64-bit
-  /// word and every integer signal is a shift and a mask of one of them, scaled with
-  /// the factor and its reciprocal. No per-signal flags are tested on this path: the
-  /// range is ±inf when the DBC gives none, the sign extension shift is 0 for unsigned
-  /// fields; float signals and unsigned 64-bit fields go through `slow_`.
+  /// word and every integer signal is a shift and a mask of one of them (Intel lanes
+  /// first, then Motorola, each accumulated in a register), sign-extended with an xor and
+  /// a subtraction (sign bit 0 for unsigned fields), scaled with the factor; encoding
+  /// multiplies by the reciprocal of the factor. No per-signal flags are tested on this
+  /// path: the range is ±inf when the DBC gives none; one test on [min|max], one on the
+  /// distance to a rounding tie and one unsigned integer compare on the field send every
+  /// other case (NaN, ±inf, a clamp, a product that might round unlike the quotient) to
+  /// SignalCodec::to_raw(), the reference. Float signals and unsigned 64-bit fields go
+  /// through `slow_`.
   struct Lane {
+    double inv_factor, offset, min_phys, max_phys, factor;
+    double half_tol;         ///< 0.5 less the largest gap between p×(1/factor) and p/factor over the field
+    std::int64_t raw_lo;     ///< smallest raw value of the field (integer)
+    std::uint64_t raw_span;  ///< largest - smallest raw value: in range iff raw - raw_lo <= raw_span (unsigned)
     std::uint64_t mask;
-    double factor, inv_factor, offset, min_phys, max_phys, raw_lo, raw_hi_excl;
-    std::uint64_t raw_min_bits, raw_max_bits;  ///< what a clamp below/above writes
+    std::uint64_t sign;    ///< the field's sign bit for signed fields, else 0: value = (raw ^ sign) - sign
     std::uint32_t index;   ///< signal index
     std::uint8_t lo;       ///< LSB position in the word
-    std::uint8_t sext;     ///< 64 - length for signed fields, else 0
     std::uint8_t word;     ///< 0 = little-endian (Intel) word, 1 = big-endian (Motorola)
   };
+  /// Raw bits of one lane for `p` (the exact to_raw() result); adds 1 to `clamped` on a clamp.
+  std::uint64_t lane_raw(const Lane& l, double p, std::uint32_t& clamped) const noexcept;
   template <bool Mux>
   std::uint32_t encode_packed(std::span<const double> values, std::uint64_t set[2], std::uint64_t clear[2]) noexcept;
-  std::vector<Lane> lanes_;          ///< integer signals of a packed message
+  std::vector<Lane> lanes_;          ///< integer signals of a packed message, Intel lanes first
+  std::uint32_t intel_lanes_ = 0;    ///< lanes_[0 .. intel_lanes_) use word 0, the rest word 1
   std::vector<std::uint32_t> slow_;  ///< the other signals of a packed message
   std::uint64_t clear_all_[2] = {0, 0};  ///< bits of every signal per word (messages without multiplexing)
   /// Multiplexing: signal i is present when its multiplexor parent_[i] is present and
