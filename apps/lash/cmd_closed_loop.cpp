@@ -1,6 +1,7 @@
 // lash closed-loop: the SPEC B2 closed loop (PID + deadzone inverse + saturation around the
 // SPEC B1 pilot valve) simulated (a) discretely and (b) continuously with ode3; step metrics of both.
 #include <cmath>
+#include <utility>
 
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
@@ -87,6 +88,9 @@ int run(const Options& o) {
   } catch (const std::invalid_argument& e) {
     throw InputError("", 0, "plant option", e.what());
   }
+  // 3600 s at the controller period bounds the trace (3.6e6 samples at 1 ms, ~0.2 GB at most).
+  for (const auto& [name, v] : {std::pair{"--settle", o.settle}, std::pair{"--after", o.after}})
+    if (!(v > 0) || !(v <= 3600.0)) throw InputError("", 0, name, "must be in (0, 3600] [s]");
   StepTest st{o.r0, o.r1, o.settle, o.after};
   if (o.online) return run_online(o, c, st);
   const StepResult d = run_step_test(Solver::discrete, p, c, st, o.bus_delay);
@@ -139,8 +143,8 @@ Command add_closed_loop(CLI::App& app) {
   sub->add_option("--gains", o->gains, "Controller TOML (default config/control/thesis_gains.toml)");
   sub->add_option("--r0", o->r0, "Reference before the step [kPa]");
   sub->add_option("--r1", o->r1, "Reference after the step [kPa]");
-  sub->add_option("--settle", o->settle, "Time at r0 before the step [s]");
-  sub->add_option("--after", o->after, "Time at r1 after the step [s]");
+  sub->add_option("--settle", o->settle, "Time at r0 before the step, (0, 3600] [s]")->capture_default_str();
+  sub->add_option("--after", o->after, "Time at r1 after the step, (0, 3600] [s]")->capture_default_str();
   sub->add_option("--deadzone", o->deadzone, "Plant deadzone [mA]");
   sub->add_option("--gain", o->gain, "Plant gain [kPa/mA]");
   sub->add_option("--tau", o->tau, "Plant time constant [s]");

@@ -32,4 +32,9 @@ out=$("$LASH" closed-loop --scenario "$d/nope.toml" 2>&1); rc=$?
 printf '%s' "${head}${win}${tail}" > "$d/ok.toml"
 out=$("$LASH" closed-loop --scenario "$d/ok.toml" --compensation sometimes 2>&1); rc=$?
 [[ $rc -eq 2 && $out == *"compensation"* ]] || { echo "FAIL bad mode: $rc $out"; fail=1; }
+# Step-test durations: bounded so the trace fits in memory, positive, finite.
+for a in "--after 1e9" "--after -1" "--after 0" "--settle 1e7" "--settle nan"; do
+  out=$("$LASH" closed-loop $a 2>&1); rc=$?
+  [[ $rc -eq 2 && $out == *"'${a%% *}'"* ]] && echo "ok   closed-loop $a: $out" || { echo "FAIL closed-loop $a: $rc $out"; fail=1; }
+done
 exit $fail
