@@ -18,19 +18,11 @@ namespace lash::py {
 namespace {
 
 Preset preset_of(const std::string& name) {
-  try {
-    return parse_preset(name);
-  } catch (const std::invalid_argument& e) {
-    throw InputError("", 0, "preset", e.what());
-  }
+  return checked("preset", [&] { return parse_preset(name); });
 }
 
 ModelKind model_of(const std::string& name) {
-  try {
-    return parse_model_kind(name);
-  } catch (const std::invalid_argument& e) {
-    throw InputError("", 0, "model", e.what());
-  }
+  return checked("model", [&] { return parse_model_kind(name); });
 }
 
 /// As `lash estimate` assembles them: the preset's settings, those chosen from the record (preset
@@ -51,11 +43,7 @@ EstimatorConfig configure(EstimationJob& job, const std::string& model, const st
 
 void validate(EstimatorConfig& cfg, const EstimationJob& job, double dt_s) {
   cfg = config_for_record(cfg, job, dt_s);
-  try {
-    cfg.validate();
-  } catch (const std::invalid_argument& e) {
-    throw InputError("", 0, "", e.what());
-  }
+  checked("", [&] { cfg.validate(); });
 }
 
 pyb::object num(double x) { return std::isfinite(x) ? pyb::object(pyb::float_(x)) : pyb::object(pyb::none()); }
@@ -105,18 +93,11 @@ class Estimator {
   }
 
   pyb::array_t<double> update_many(const pyb::handle& v_obj, const pyb::handle& y_obj, const pyb::handle& t_obj) {
-    const DoubleArray va = as_doubles(v_obj, "v"), ya = as_doubles(y_obj, "y");
-    const auto v = span_of(va), y = span_of(ya);
-    if (v.size() != y.size())
-      throw InputError("", 0, "y", "has " + std::to_string(y.size()) + " samples, v has " + std::to_string(v.size()));
-    DoubleArray ta;
-    std::span<const double> t;
-    if (!t_obj.is_none()) {
-      ta = as_doubles(t_obj, "t");
-      t = span_of(ta);
-      if (t.size() != v.size())
-        throw InputError("", 0, "t", "has " + std::to_string(t.size()) + " samples, v has " + std::to_string(v.size()));
-    }
+    const Doubles va(v_obj, "v"), ya(y_obj, "y");
+    ya.require_length_of(va);
+    const Doubles ta = t_obj.is_none() ? Doubles() : Doubles(t_obj, "t");
+    if (!t_obj.is_none()) ta.require_length_of(va);
+    const auto v = va.span(), y = ya.span(), t = ta.span();
     std::vector<double> yhat(v.size());
     {
       pyb::gil_scoped_release nogil;
@@ -184,12 +165,10 @@ Result estimate(const pyb::handle& t_obj, const pyb::handle& v_obj, const pyb::h
                 const pyb::kwargs& settings) {
   EstimationJob job;
   configure(job, model, preset, 1.0, settings);  // settings are checked before the data is looked at
-  const DoubleArray ta = as_doubles(t_obj, "t"), va = as_doubles(v_obj, "v"), ya = as_doubles(y_obj, "y");
-  const auto t = span_of(ta), v = span_of(va), y = span_of(ya);
-  if (v.size() != t.size())
-    throw InputError("", 0, "v", "has " + std::to_string(v.size()) + " samples, t has " + std::to_string(t.size()));
-  if (y.size() != t.size())
-    throw InputError("", 0, "y", "has " + std::to_string(y.size()) + " samples, t has " + std::to_string(t.size()));
+  const Doubles ta(t_obj, "t"), va(v_obj, "v"), ya(y_obj, "y");
+  va.require_length_of(ta);
+  ya.require_length_of(ta);
+  const auto t = ta.span(), v = va.span(), y = ya.span();
   const double dt = sample_period(t, "", {}, "t");
   EstimatorConfig cfg = configure(job, model, preset, dt, settings, v, y);
   validate(cfg, job, dt);
