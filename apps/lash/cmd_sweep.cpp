@@ -34,7 +34,7 @@ void write_trace(const sweep::Campaign& c, const std::vector<std::string>& arg) 
   try {
     std::size_t used = 0;
     const unsigned long long v = std::stoull(arg[0], &used);
-    if (used != arg[0].size()) throw std::invalid_argument(arg[0]);
+    if (used != arg[0].size() || arg[0].find('-') != std::string::npos) throw std::invalid_argument(arg[0]);
     idx = static_cast<std::size_t>(v);
   } catch (const std::exception&) {
     throw InputError("", 0, "--trace", "RUN must be a run number (column 'run' of the results), got '" + arg[0] + "'");

@@ -18,7 +18,7 @@ struct Options {
   double r0 = 0.0, r1 = 1000.0;
   int samples = 30000, restarts = 16;
   bool tune_filter = false;
-  std::uint64_t seed = 1;
+  std::int64_t seed = 1;
   bool json = false;
   std::string out;
 };
@@ -43,7 +43,7 @@ int run(const Options& o) {
   t.samples = o.samples;
   t.restarts = o.restarts;
   t.tune_filter = o.tune_filter;
-  t.seed = o.seed;
+  t.seed = static_cast<std::uint64_t>(o.seed);
   const TuneResult r = tune_pid(t);
   ControllerConfig c = t.controller;
   c.pid.gains = r.gains;
@@ -101,7 +101,7 @@ Command add_tune(CLI::App& app) {
   sub->add_option("--restarts", o->restarts, "Nelder-Mead restarts from the best samples, 1..10000")
       ->check(CLI::Range(1, 10'000));
   sub->add_flag("--tune-filter", o->tune_filter, "Also search the derivative filter N (default N = 0)");
-  sub->add_option("--seed", o->seed, "Search seed");
+  sub->add_option("--seed", o->seed, "Search seed, >= 0")->check(CLI::Range(std::int64_t{0}, INT64_MAX));
   sub->add_flag("--json", o->json, "Print one JSON object");
   sub->add_option("-o,--output", o->out, "Write the gains as a controller TOML (checked before the search)");
   return {sub, [o] { return run(*o); }};
