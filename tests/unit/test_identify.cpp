@@ -203,14 +203,21 @@ void expect_dzdb(const AnyEstimator& e, const Truth& t, double tol, const std::s
   EXPECT_LE(rel_err(l.d, t.dl), tol) << when << " d_l " << l.d;
 }
 
-TEST(Estimators, E1NoiseFreeThesisEq34) {
+/// The eq-34 plant (E1/E2) driven by 600 sin(t) for `duration_s`, noise of `noise_variance` on y.
+SimulationTrace eq34_sine(double duration_s, double noise_variance = 0.0, std::uint64_t seed = 1) {
   Plant plant = load_plant(std::string(LASH_SOURCE_DIR) + "/config/plants/thesis_eq34.toml");
   SimulationSpec spec;
   spec.input.kind = Waveform::sine;
   spec.input.amplitude = 600;
   spec.input.frequency_rad_s = 1;
-  spec.duration_s = 200;
-  const SimulationTrace tr = simulate(plant, spec);
+  spec.duration_s = duration_s;
+  spec.noise_variance = noise_variance;
+  spec.seed = seed;
+  return simulate(plant, spec);
+}
+
+TEST(Estimators, E1NoiseFreeThesisEq34) {
+  const SimulationTrace tr = eq34_sine(200);
   AnyEstimator e(thesis_config());
   const Truth truth{-0.96, 0.1, 200, 30, -0.94, 0.15, -300, 50};
   const auto& v = tr.col("v");
@@ -474,15 +481,7 @@ TEST(Estimators, GapRestartOnE2DataMatchesARestartByHand) {
   // E2-like: the eq-34 plant, noise variance 200, 1 rad/s sine of 600, lash's settings for the
   // model; 7 s unrecorded after t = 100 s. The run loop's restart equals the one done by hand, and
   // the estimates keep E2's bounds (a1 1 %, b1 3 %, c 3 %, d 10 %).
-  Plant plant = load_plant(std::string(LASH_SOURCE_DIR) + "/config/plants/thesis_eq34.toml");
-  SimulationSpec spec;
-  spec.input.kind = Waveform::sine;
-  spec.input.amplitude = 600;
-  spec.input.frequency_rad_s = 1;
-  spec.duration_s = 210;
-  spec.noise_variance = 200;
-  spec.seed = 3;
-  const SimulationTrace tr = simulate(plant, spec);
+  const SimulationTrace tr = eq34_sine(210, 200, 3);
   // 7 s missing (one period and 0.72 rad): the output rises at both ends and jumps up across it
   const std::size_t from = rising_gap(tr.col("v"), tr.col("y_true"), 20000, 1400, 100.0, 350.0), to = from + 1400;
   ASSERT_GT(from, 0u);
