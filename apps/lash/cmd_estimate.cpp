@@ -93,13 +93,13 @@ int run(const EstimateOptions& o) {
   cfg.fit_start_s = job.nrmse_t0_s;  // the verdict's fit window starts where the reported NRMSE's does
   const bool keep = !o.out.empty() || !o.plot.empty();
   const auto t_start = std::chrono::steady_clock::now();
-  AutoRun ar = estimate_auto(cfg, rec.v(), rec.y(), keep, o.outlier_gate);
+  AutoRun ar = estimate_auto(cfg, rec.v(), rec.y(), keep, o.outlier_gate, rec.gap_rows());
   EstimationRun& run = ar.run;
   const double elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   if (o.timing)
     fmt::print(stderr, "lash estimate: estimator ran {} samples in {} s ({:.3g} M samples/s)\n", rec.v().size(),
                format_double(elapsed_s), static_cast<double>(rec.v().size()) / elapsed_s * 1e-6);
-  add_intervals(run, ar.cfg, rec.v(), rec.y());
+  add_intervals(run, ar.cfg, rec.v(), rec.y(), rec.gap_rows());
   const auto& t = rec.t();
   const double t1 = job.nrmse_t1_s < 0 ? t.back() : job.nrmse_t1_s;
   const double fit = nrmse(t, rec.y(), run.ysim, job.nrmse_t0_s, t1);

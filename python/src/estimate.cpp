@@ -146,6 +146,8 @@ class Estimator {
   }
   double next_t() const noexcept { return static_cast<double>(t_.size()) * cfg_.dt_s; }
   void step(double v, double y, double t) {
+    // a step of t longer than kGapFactor sample periods is a gap (io/table.hpp): restart there
+    if (!t_.empty() && t - t_.back() > kGapFactor * cfg_.dt_s) est_->restart();
     t_.push_back(t);
     v_.push_back(v);
     y_.push_back(y);
@@ -169,15 +171,18 @@ Result estimate(const pyb::handle& t_obj, const pyb::handle& v_obj, const pyb::h
   va.require_length_of(ta);
   ya.require_length_of(ta);
   const auto t = ta.span(), v = va.span(), y = ya.span();
-  const double dt = sample_period(t, "", {}, "t");
+  sample_period(t, "", {}, "t");  // checks t (strictly increasing, at least 3 samples)
+  // as load_record: dt is the mean step without the gaps, and the estimator restarts at each gap
+  const Sampling smp = analyse_sampling(std::vector<double>(t.begin(), t.end()));
+  const double dt = smp.dt;
   EstimatorConfig cfg = configure(job, model, preset, dt, settings, v, y);
   validate(cfg, job, dt);
   std::optional<AutoRun> ar;
   std::optional<EstimateResult> res;
   {
     pyb::gil_scoped_release nogil;
-    ar.emplace(estimate_auto(cfg, v, y, trace, outlier_gate));
-    if (intervals) add_intervals(ar->run, ar->cfg, v, y);
+    ar.emplace(estimate_auto(cfg, v, y, trace, outlier_gate, smp.gap_rows));
+    if (intervals) add_intervals(ar->run, ar->cfg, v, y, smp.gap_rows);
     res.emplace(score_estimate(ar->run.report, dt, job, t, y, ar->run.ysim));
   }
   EstimationRun* run = &ar->run;
@@ -258,7 +263,8 @@ void bind_estimate(pyb::module_& m) {
            pyb::arg("dt_s"), pyb::kw_only(), pyb::arg("preset") = "thesis")
       .def("update", &Estimator::update, pyb::arg("v"), pyb::arg("y"), pyb::arg("t_s") = pyb::none(),
            "update(v, y, t_s=None) -> yhat: one sample v [input unit], y [output unit] at time t_s [s]\n"
-           "(default k*dt_s; only the NRMSE window uses it). Returns the one-step prediction [output unit].")
+           "(default k*dt_s; the NRMSE window uses it, and a step of t longer than 5 dt_s is a gap: the\n"
+           "estimator restarts its regressors there). Returns the one-step prediction [output unit].")
       .def("update_many", &Estimator::update_many, pyb::arg("v"), pyb::arg("y"), pyb::arg("t") = pyb::none(),
            "update_many(v, y, t=None) -> yhat array: 1-D arrays of equal length (t [s] optional, as in update).\n"
            "Same bits as update() sample by sample.")

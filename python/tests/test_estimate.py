@@ -83,6 +83,24 @@ def test_streaming_equals_batch_bit_for_bit(e2_csv):
     assert many.result().json == batch.json
 
 
+def test_gap_restarts_streaming_and_batch_alike(e2_csv):
+    """A record with 7 s missing: lash.estimate (dt without the gap, restart at the gap row) and the
+    streaming Estimator given t (restart where t steps by more than 5 dt) agree bit for bit, and the
+    restart changes the estimate against the same samples without the gap in t."""
+    d = read_csv(e2_csv)
+    keep = np.r_[0:6000, 7400:14000]  # rows 6000..7399 (7 s) not recorded
+    t, v, y = d["t"][keep], d["v"][keep], d["y"][keep]
+    dt = t[1] - t[0]
+    batch = lash.estimate(t, v, y, preset="thesis", outlier_gate=0, **E2_SETTINGS)
+    assert batch.dt_s == (t[-1] - t[0] - (t[6000] - t[5999])) / (len(t) - 2)  # the gap is not in dt
+    many = lash.Estimator("deadzone-deadband", batch.dt_s, **E2_SETTINGS)
+    assert many.update_many(v, y, t=t).tobytes() == batch.yhat.tobytes()
+    assert many.result().json == batch.json
+    # the same samples on an even time base (no gap): no restart, another estimate
+    flat = lash.estimate(np.arange(len(t)) * dt, v, y, preset="thesis", outlier_gate=0, **E2_SETTINGS)
+    assert flat.yhat.tobytes() != batch.yhat.tobytes()
+
+
 def test_default_time_base_is_k_dt():
     """Without t, sample k is at k*dt_s: equals lash.estimate on t = arange(n)*dt when dt is exact."""
     dt = 2.0 ** -7  # exact in binary, so mean step of k*dt is dt again

@@ -62,6 +62,8 @@ FirstOrder::FirstOrder(PerSide<FirstOrderParams> p) : p_(p) {
 MovingAverage::MovingAverage(std::size_t length) {
   require(length >= 1, "moving average length must be >= 1");
   buf_.assign(length, 0.0);
+  len_ = static_cast<double>(length);
+  n_ = length;
 }
 void MovingAverage::reset() noexcept {
   for (auto& v : buf_) v = 0.0;

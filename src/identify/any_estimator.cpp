@@ -99,7 +99,8 @@ EstimateReport AnyEstimator::report() const {
 }
 
 EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> v, std::span<const double> y,
-                            bool keep_trace, const std::function<void(const AnyEstimator&)>& at_end) {
+                            bool keep_trace, const std::function<void(const AnyEstimator&)>& at_end,
+                            std::span<const std::size_t> gap_rows) {
   if (v.size() != y.size()) throw std::invalid_argument("v and y differ in length");
   AnyEstimator est(cfg);
   EstimationRun run;
@@ -109,22 +110,24 @@ EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> 
   run.param_names = est.param_names();
   std::vector<double> pv(run.param_names.size());
   if (keep_trace) run.params.assign(pv.size(), std::vector<double>(n));
-  for (std::size_t k = 0; k < n; ++k) {
-    run.yhat[k] = est.step(v[k], y[k]);
+  step_through(est, v, y, 0, n, gap_rows, [&](std::size_t k) {
+    run.yhat[k] = est.prediction();
     run.ysim[k] = est.simulated();
     if (keep_trace) {
       est.param_values(pv);
       for (std::size_t p = 0; p < pv.size(); ++p) run.params[p][k] = pv[p];
     }
-  }
+  });
   run.report = est.report();
   if (at_end) at_end(est);
   return run;
 }
 
 void add_intervals(EstimationRun& run, const EstimatorConfig& cfg, std::span<const double> v,
-                   std::span<const double> y) {
-  const auto ci = batch_means_intervals(cfg, v, y, {run.report.right.params, run.report.left.params});
+                   std::span<const double> y, std::span<const std::size_t> gap_rows) {
+  IntervalSettings s;
+  s.gap_rows = gap_rows;
+  const auto ci = batch_means_intervals(cfg, v, y, {run.report.right.params, run.report.left.params}, s);
   if (run.report.right.params.identified) run.report.right.ci95 = ci.right;
   if (run.report.left.params.identified) run.report.left.ci95 = ci.left;
 }

@@ -244,7 +244,7 @@ void tune_to_data(EstimatorConfig& c, const DataTraits& d) {
 }
 
 AutoRun estimate_auto(const EstimatorConfig& cfg0, std::span<const double> v, std::span<const double> y_raw,
-                      bool keep_trace, double gate) {
+                      bool keep_trace, double gate, std::span<const std::size_t> gap_rows) {
   AutoRun out;
   // The gate is causal (usable online); over a whole record the sample after a flagged one is also
   // known: when it lies nearer the flagged value than the last accepted one, the output really
@@ -272,7 +272,7 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, std::span<const double> v, st
   const bool search_r = uses_guesses(cfg.model) && std::isinf(cfg.guess_right);
   const bool search_l = uses_guesses(cfg.model) && std::isinf(cfg.guess_left);
   if (search_r || search_l) {
-    const auto g = search_guesses(cfg, v, y);
+    const auto g = search_guesses(cfg, v, y, gap_rows);
     if (search_r) cfg.guess_right = g[0];
     if (search_l) cfg.guess_left = g[1];
   }
@@ -281,7 +281,7 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, std::span<const double> v, st
     if (!uses_guesses(cfg.model)) return;
     out.right.edge = raw_edge(est, Side::right);
     out.left.edge = raw_edge(est, Side::left);
-  });
+  }, gap_rows);
   if (uses_guesses(cfg.model)) {
     out.right.guess = cfg.guess_right;
     out.left.guess = cfg.guess_left;
@@ -294,7 +294,7 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, std::span<const double> v, st
 }
 
 std::array<double, 2> search_guesses(const EstimatorConfig& cfg0, std::span<const double> v,
-                                     std::span<const double> y) {
+                                     std::span<const double> y, std::span<const std::size_t> gap_rows) {
   if (!uses_guesses(cfg0.model)) return {kInf, -kInf};
   const DataTraits d = analyse_record(v, y, cfg0.dt_s);
   const double hi = std::max(d.v_hi, 0.0), lo = std::min(d.v_lo, 0.0);
@@ -306,7 +306,7 @@ std::array<double, 2> search_guesses(const EstimatorConfig& cfg0, std::span<cons
     cfg.guess_right = g[0] > 0.0 ? g[0] : kInf;
     cfg.guess_left = g[1] < 0.0 ? g[1] : -kInf;
     AnyEstimator est(cfg);
-    for (std::size_t k = 0; k < v.size(); ++k) est.step(v[k], y[k]);
+    step_through(est, v, y, 0, v.size(), gap_rows, [](std::size_t) {});
     std::array<double, 2> next = g;
     for (int i = 0; i < 2; ++i) {
       const Side s = i == 0 ? Side::right : Side::left;

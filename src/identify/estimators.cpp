@@ -38,8 +38,15 @@ std::uint64_t fit_start_index(const EstimatorConfig& c) {
 // ---------------------------------------------------------------- linear (eq. 9–16)
 
 LinearEstimator::LinearEstimator(const EstimatorConfig& cfg)
-    : cfg_(checked(cfg)), pre_(cfg.noise, cfg.dt_s), rls_(cfg.rls2()) {
+    : cfg_(checked(cfg)), pre_(cfg.noise, cfg.dt_s), rls_(cfg.rls2()), warmup_(detail::warmup_samples(cfg, pre_)) {
   fit_.k0 = fit_start_index(cfg);
+}
+
+void LinearEstimator::restart() noexcept {
+  pre_.reset();
+  hist_ = {};
+  y1_ = v1_ = 0.0;
+  warm_ = warmup_;
 }
 
 double LinearEstimator::step(double v, double y) noexcept {
@@ -49,11 +56,16 @@ double LinearEstimator::step(double v, double y) noexcept {
   }
   const Conditioned s = pre_.step(v, y);
   const std::array<double, 2> phi{-y1_, v1_};
-  if (cfg_.method == EstimationMethod::iv)
+  const bool warming = warm_ > 0;  // after a gap: the regressors are not all from this side of it yet
+  if (warming) {
+    --warm_;
+    yhat_ = rls_.predict(phi);
+  } else if (cfg_.method == EstimationMethod::iv) {
     yhat_ = rls_.update_iv(phi, {-hist_.ago(1 + cfg_.iv_delay), v1_}, s.y);
-  else
+  } else {
     yhat_ = rls_.update(phi, s.y);
-  if (rls_.updates() > 1) {  // the first update's regressors are the zero initial state, not data
+  }
+  if (!warming && rls_.updates() > 1) {  // the first update's regressors are the zero initial state, not data
     vrange_.add(v1_);
     yrange_.add(y1_);
   }
@@ -92,8 +104,18 @@ Reason LinearEstimator::verdict(Side) const noexcept {
 namespace detail {
 
 TwoSideEstimator::TwoSideEstimator(const EstimatorConfig& cfg)
-    : cfg_(checked(cfg)), pre_(cfg.noise, cfg.dt_s), rls_{Rls<3>(cfg.rls3()), Rls<3>(cfg.rls3())} {
+    : cfg_(checked(cfg)),
+      pre_(cfg.noise, cfg.dt_s),
+      rls_{Rls<3>(cfg.rls3()), Rls<3>(cfg.rls3())},
+      warmup_(warmup_samples(cfg, pre_)) {
   fit_.k0 = fit_start_index(cfg);
+}
+
+void TwoSideEstimator::restart() noexcept {
+  pre_.reset();
+  hist_ = {};
+  y1_ = v1_ = 0.0;
+  warm_ = warmup_;
 }
 
 void TwoSideEstimator::refresh(Side s, double c, bool guess_ok) noexcept {
@@ -157,7 +179,9 @@ double InputDeadzoneEstimator::step(double v, double y) noexcept {
     return yhat_ = kNaN;
   }
   const Conditioned s = pre_.step(v, y);
-  if (const auto side = detail::guess_side(v1_, cfg_)) {
+  const auto side = detail::guess_side(v1_, cfg_);
+  if (warm_ > 0) --warm_;  // after a gap: no update (see restart())
+  if (side && warm_ == 0) {
     yhat_ = update(*side, s.y);
     refresh(*side);
     last_ = *side;
@@ -203,10 +227,12 @@ double OutputDeadzoneEstimator::step(double v, double y) noexcept {
     ysim_ = detail::deadzone(x_, sc_.left, sc_.right);
     vraw1_ = v;
   }
-  if (s.y > z && y1 > z) {
+  const bool warming = warm_ > 0;  // after a gap: no update (see restart())
+  if (warming) --warm_;
+  if (!warming && s.y > z && y1 > z) {
     yhat_ = update(Side::right, s.y);
     refresh(Side::right);
-  } else if (s.y < -z && y1 < -z) {
+  } else if (!warming && s.y < -z && y1 < -z) {
     yhat_ = update(Side::left, s.y);
     refresh(Side::left);
   } else if (y1 > z) {
@@ -231,9 +257,20 @@ DeadzoneDeadbandEstimator::DeadzoneDeadbandEstimator(const EstimatorConfig& cfg)
     : cfg_(checked(cfg)),
       pre_(cfg.noise, cfg.dt_s),
       rls_{Rls<3>(cfg.rls3()), Rls<3>(cfg.rls3()), Rls<3>(cfg.rls3()), Rls<3>(cfg.rls3())},
-      pooled_{Rls<4>(cfg.rls4()), Rls<4>(cfg.rls4())} {
+      pooled_{Rls<4>(cfg.rls4()), Rls<4>(cfg.rls4())},
+      warmup_(detail::warmup_samples(cfg, pre_)) {
   sc_ = {cfg.guess_right, cfg.guess_left};
   fit_.k0 = fit_start_index(cfg);
+}
+
+void DeadzoneDeadbandEstimator::restart() noexcept {
+  pre_.reset();
+  hist_ = {};
+  y1_ = v1_ = 0.0;
+  dir1_ = 0;
+  side1_.reset();
+  run_ = 0;
+  warm_ = warmup_;
 }
 
 double DeadzoneDeadbandEstimator::step(double v, double y) noexcept {
@@ -247,6 +284,10 @@ double DeadzoneDeadbandEstimator::step(double v, double y) noexcept {
   const std::optional<Side> side = detail::guess_side(v1, cfg_);
   run_ = (dir != 0 && dir == dir1_ && side == side1_) ? run_ + 1 : 1;
   side1_ = side;
+  if (warm_ > 0) {  // after a gap (restart()): the direction hold starts again once the history is refilled
+    --warm_;
+    run_ = 0;
+  }
   if (side && dir != 0 && run_ >= cfg_.direction_run) {
     const Side sd = *side;
     const Key k = key(sd, dir > 0);
@@ -421,9 +462,20 @@ double DeadzoneDeadbandEstimator::predict_free(Side side, double y1, double v1) 
 // ---------------------------------------------------------------- coupled carts (§1.6.3)
 
 CoupledCartsEstimator::CoupledCartsEstimator(const EstimatorConfig& cfg)
-    : cfg_(checked(cfg)), pre_(cfg.noise, cfg.dt_s), rls_{Rls<3>(cfg.rls3()), Rls<3>(cfg.rls3())} {
+    : cfg_(checked(cfg)),
+      pre_(cfg.noise, cfg.dt_s),
+      rls_{Rls<3>(cfg.rls3()), Rls<3>(cfg.rls3())},
+      warmup_(detail::warmup_samples(cfg, pre_)) {
   stage2_k_ = static_cast<std::uint64_t>(std::ceil(cfg.stage2_start_s / cfg.dt_s - 1e-9));
   fit_.k0 = fit_start_index(cfg);
+}
+
+void CoupledCartsEstimator::restart() noexcept {
+  pre_.reset();
+  vel1_ = v1_ = y1_ = 0.0;
+  dir1_ = dir2_ = 0;
+  r_ok_ = false;  // a slot crossing is never measured across the gap
+  warm_ = warmup_;
 }
 
 std::uint64_t CoupledCartsEstimator::skipped() const noexcept {
@@ -504,7 +556,9 @@ double CoupledCartsEstimator::step(double v, double y) noexcept {
   const double vel1 = vel1_, v1 = v1_;
   const bool steady = std::fabs(vel - vel1) * (1.0 / cfg_.dt_s) <= cfg_.accel_limit;
   double vel_pred = 0.0;
-  if (dir != 0 && dir == dir1_ && dir == dir2_ && steady) {
+  const bool warming = warm_ > 0;  // after a gap: no update (see restart())
+  if (warming) --warm_;
+  if (!warming && dir != 0 && dir == dir1_ && dir == dir2_ && steady) {
     const Side i = dir > 0 ? Side::right : Side::left;
     vel_pred = rls_[i].update({-vel1, v1, 1.0}, vel);
     vrange_[i].add(v1);
@@ -530,7 +584,7 @@ double CoupledCartsEstimator::step(double v, double y) noexcept {
   // the velocity model, so o drifts; d is therefore taken per crossing of the slot, where the
   // drift cancels: when the free cart starts moving the other way, the change of y − ŵ since its
   // last moving sample is ±2d. d is the mean over crossings; o the least-squares offset given d.
-  if (k_ >= stage2_k_ && valid_.right && valid_.left && dir != 0) {
+  if (!warming && k_ >= stage2_k_ && valid_.right && valid_.left && dir != 0) {
     const double r = s.y - w_;
     if (r_ok_ && dir != dir_last_) {
       dsum_ += 0.5 * (r - r_last_) * static_cast<double>(dir_last_);

@@ -1,5 +1,7 @@
 #include "lash/identify/preprocess.hpp"
 
+#include <algorithm>
+
 namespace lash {
 
 Preprocessor::Preprocessor(const NoiseSettings& s, double dt_s)
@@ -31,6 +33,15 @@ void Preprocessor::reset() noexcept {
   delay_v_.reset();
   align_v_.reset();
   align_y_.reset();
+}
+
+std::size_t Preprocessor::memory_samples() const noexcept {
+  if (identity_) return 1;  // ẏ = (y − y_prev)/T
+  const std::size_t m = filter_y_ ? s_.filter_length : 1;
+  const std::size_t regression = std::max(m, filter_v_ ? s_.filter_length : 1) + s_.input_delay + s_.align_delay;
+  const std::size_t pre = separate_pre_ ? (filter_p_ ? s_.derivative_prefilter_length : 1) : m;
+  const std::size_t derivative = pre + 1 + (filter_d_ ? s_.derivative_filter_length : 1);
+  return std::max(regression, derivative);
 }
 
 double Preprocessor::output_delay_samples() const noexcept {

@@ -201,6 +201,47 @@ TYPED_TEST(EstimatorInvariants, NoHeapAllocationInUpdate) {
   EXPECT_GT(g_allocations.load(), after);
 }
 
+// restart() after a gap: the parameters, covariances and counts stay; the signal history goes.
+/// The parameter side of observe(): what restart() must keep (not ŷ, y_sim or the fit verdict).
+template <class E>
+std::vector<double> estimates(const E& e) {
+  std::vector<double> o;
+  for (Side s : {Side::right, Side::left}) {
+    const SideParams p = e.params(s);
+    o.insert(o.end(), {p.a1, p.b1, p.c, p.d, static_cast<double>(p.reason), static_cast<double>(e.updates(s))});
+  }
+  return o;
+}
+
+TYPED_TEST(EstimatorInvariants, RestartKeepsEstimatesAndClearsTheSignalHistory) {
+  TypeParam a(config_for<TypeParam>()), b(config_for<TypeParam>());
+  static_assert(noexcept(a.restart()), "restart() must be noexcept");
+  const auto& r = this->rec;
+  for (std::size_t k = 0; k < 3000; ++k) {
+    a.step(r.v[k], r.y[k]);
+    b.step(r.v[k], r.y[k]);
+  }
+  const std::vector<double> before = estimates(a);
+  const std::size_t allocs = g_allocations.load();
+  a.restart();
+  b.restart();
+  EXPECT_EQ(g_allocations.load(), allocs) << "restart() allocated";
+  ASSERT_TRUE(same_bits(estimates(a), before)) << "restart() changed an estimate";
+  ASSERT_GE(b.warmup(), 3u);
+  // b sees junk for less than its warm-up: nothing may be updated from it, and after a second
+  // restart() nothing of it may remain — b then follows a bit for bit.
+  for (std::uint32_t k = 0; k + 1 < b.warmup(); ++k) b.step(5000.0 * (k % 2 ? 1.0 : -1.0), -700.0 * k);
+  ASSERT_TRUE(same_bits(estimates(b), before)) << "a sample of the warm-up updated an estimate";
+  b.restart();
+  for (std::size_t k = 3000; k < r.v.size(); ++k) {
+    const double ya = a.step(r.v[k], r.y[k]), yb = b.step(r.v[k], r.y[k]);
+    ASSERT_TRUE(same_bits({ya}, {yb})) << "sample " << k;
+    ASSERT_TRUE(same_bits(estimates(a), estimates(b))) << "sample " << k;
+  }
+  EXPECT_GT(a.updates(Side::right) + a.updates(Side::left), static_cast<std::uint64_t>(before[5] + before[11]))
+      << "updates resume after the warm-up";
+}
+
 // verdict_rules: the order of the checks and the condition test, with hand-made cases.
 TEST(Verdict, ChecksInOrder) {
   verdict_rules::Evidence e;

@@ -2,6 +2,7 @@
 /// @file any_estimator.hpp
 /// One type for every estimator of SPEC A4 (a std::variant, no virtual calls), plus a
 /// summary report and a batch runner used by `lash estimate`, `lash demo` and sweeps.
+#include <algorithm>
 #include <functional>
 #include <cstdint>
 #include <span>
@@ -72,6 +73,11 @@ class AnyEstimator {
     return std::visit([](const auto& e) noexcept { return e.skipped(); }, e_);
   }
   std::uint64_t samples() const noexcept { return samples_; }
+  /// After a gap in the record: clears the signal history, keeps the estimates (estimators.hpp).
+  /// noexcept, allocation-free.
+  void restart() noexcept {
+    std::visit([](auto& e) noexcept { e.restart(); }, e_);
+  }
   /// Back to the state right after construction. Not real-time safe.
   void reset() {
     std::visit([](auto& e) { e.reset(); }, e_);
@@ -96,6 +102,24 @@ class AnyEstimator {
   std::uint64_t samples_ = 0;
 };
 
+/// Steps `est` through samples [begin, end) of v, y, calling est.restart() before every row listed
+/// in `gap_rows` (ascending row indices where a gap ends, as Record::gap_rows() / Table::gap_rows;
+/// a gap row outside the range is ignored), and `each(k)` after the step of sample k. The one run
+/// loop of every whole-record estimation (run_estimator, search_guesses, the intervals' sections).
+template <class Each>
+void step_through(AnyEstimator& est, std::span<const double> v, std::span<const double> y, std::size_t begin,
+                  std::size_t end, std::span<const std::size_t> gap_rows, Each&& each) {
+  auto gap = std::lower_bound(gap_rows.begin(), gap_rows.end(), begin);
+  for (std::size_t k = begin; k < end; ++k) {
+    if (gap != gap_rows.end() && *gap == k) {
+      if (k > begin) est.restart();  // at `begin` the history is already empty (new or reset estimator)
+      ++gap;
+    }
+    est.step(v[k], y[k]);
+    each(k);
+  }
+}
+
 /// Result of running an estimator over a whole record.
 struct EstimationRun {
   EstimateReport report;
@@ -106,13 +130,15 @@ struct EstimationRun {
 
 /// Steps `cfg`'s estimator through v, y (same length). keep_trace stores the parameters per step.
 /// `at_end`, when given, is called with the estimator after the last sample (to read more of its
-/// final state without a second pass over the record).
+/// final state without a second pass over the record). `gap_rows`: where the record's timestamps
+/// jump (step_through): the estimator restarts its regressors there.
 EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> v, std::span<const double> y,
                             bool keep_trace = false,
-                            const std::function<void(const AnyEstimator&)>& at_end = {});
+                            const std::function<void(const AnyEstimator&)>& at_end = {},
+                            std::span<const std::size_t> gap_rows = {});
 /// Adds the 95 % intervals of every identified side's parameters to run.report (batch means,
 /// intervals.hpp: runs the estimator once more over sections of the same record).
 void add_intervals(EstimationRun& run, const EstimatorConfig& cfg, std::span<const double> v,
-                   std::span<const double> y);
+                   std::span<const double> y, std::span<const std::size_t> gap_rows = {});
 
 }  // namespace lash

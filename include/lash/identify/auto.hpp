@@ -86,13 +86,15 @@ struct AutoRun {
 /// halfway out when ĉ lies beyond c* (inside-the-deadzone guess), until c* moves less than 1 %
 /// of the input span (at most 5 passes). Not real-time safe.
 /// y first passes the outlier gate (auto_gate.hpp) with threshold `gate` (0 = off).
+/// `gap_rows`: where the record's timestamps jump (Record::gap_rows()); every run restarts its
+/// estimator's regressors there (AnyEstimator::restart).
 AutoRun estimate_auto(const EstimatorConfig& cfg, std::span<const double> v, std::span<const double> y,
-                      bool keep_trace = false, double gate = 12.0);
+                      bool keep_trace = false, double gate = 12.0, std::span<const std::size_t> gap_rows = {});
 
 /// The switching guesses estimate_auto would use on this record ({c_r*, c_l*}); for the sweep,
 /// which runs its estimator online on a rig whose open-loop record it can take first.
 std::array<double, 2> search_guesses(const EstimatorConfig& cfg, std::span<const double> v,
-                                     std::span<const double> y);
+                                     std::span<const double> y, std::span<const std::size_t> gap_rows = {});
 
 /// The settings as a TOML document that `read_estimator_config` (`lash estimate --config`)
 /// reads back to the same EstimatorConfig (every key written; infinities as ±inf).

@@ -10,6 +10,13 @@
 /// is NaN — never a huge number.
 ///
 /// Regression (SPEC A4): φ(k) = [−y(k−1), v(k−1), 1], η = [a1, b1, e].
+///
+/// restart() (after a gap in the record's timestamps, docs/identification.md "Gaps") clears the
+/// signal history — filters, delays, derivative, the direction-hold counters, the previous samples
+/// and the instruments — but keeps the parameter estimates, covariances, update counts and the
+/// verdict's evidence. The next warmup() samples refill that history and update nothing, so no
+/// regression ever mixes samples from both sides of a gap. The free-run simulation y_sim is a
+/// model driven by v alone, not a regression: it runs on. restart() is noexcept and allocation-free.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -32,6 +39,12 @@ constexpr double deadzone(double x, double cl, double cr) noexcept {
   return x > cr ? x - cr : (x < cl ? x - cl : 0.0);
 }
 using ValueRange = verdict_rules::ValueRange;
+/// Samples after a restart() before a regression may use a sample again: the preprocessor's
+/// memory, the previous samples y(k−1), y(k−2) and, for IV, the instrument's delay.
+inline std::uint32_t warmup_samples(const EstimatorConfig& c, const Preprocessor& p) noexcept {
+  const std::size_t iv = c.method == EstimationMethod::iv ? c.iv_delay + 1 : 0;
+  return static_cast<std::uint32_t>(p.memory_samples() + 2 + iv);
+}
 /// Fixed ring of the last 64 values (instrument history).
 struct History {
   std::array<double, 64> buf{};
@@ -89,11 +102,16 @@ class LinearEstimator {
   const EstimatorConfig& config() const noexcept { return cfg_; }
   /// Back to the state right after construction. Not real-time safe (reallocates the filters).
   void reset() { *this = LinearEstimator(cfg_); }
+  /// After a gap: clears the signal history, keeps the estimates (see the file comment).
+  void restart() noexcept;
+  /// Samples after restart() that update nothing.
+  std::uint32_t warmup() const noexcept { return warmup_; }
 
  private:
   EstimatorConfig cfg_;
   Preprocessor pre_;
   Rls<2> rls_;
+  std::uint32_t warmup_ = 0, warm_ = 0;  // warm-up length; samples of it still to go
   detail::History hist_;
   detail::ValueRange vrange_, yrange_;
   detail::FitWindow fit_;
@@ -118,6 +136,9 @@ class TwoSideEstimator {
   double fit_nrmse() const noexcept { return fit_.nrmse(); }
   const Rls<3>& rls(Side s) const noexcept { return rls_[s]; }
   const EstimatorConfig& config() const noexcept { return cfg_; }
+  /// After a gap: clears the signal history, keeps the estimates (see the file comment).
+  void restart() noexcept;
+  std::uint32_t warmup() const noexcept { return warmup_; }
 
  protected:
   explicit TwoSideEstimator(const EstimatorConfig& cfg);
@@ -131,6 +152,7 @@ class TwoSideEstimator {
   EstimatorConfig cfg_;
   Preprocessor pre_;
   PerSide<Rls<3>> rls_;
+  std::uint32_t warmup_ = 0, warm_ = 0;
   PerSide<SideParams> p_{};
   PerSide<double> sa1_{}, sb1_{}, sc_{};  // parameters used by the free-run simulation
   PerSide<ValueRange> vrange_{}, yrange_{};  // v(k−1), y(k−1) over each side's updates
@@ -185,6 +207,9 @@ class DeadzoneDeadbandEstimator {
   explicit DeadzoneDeadbandEstimator(const EstimatorConfig& cfg);
   double step(double v, double y) noexcept;
   void reset() { *this = DeadzoneDeadbandEstimator(cfg_); }
+  /// After a gap: clears the signal history, keeps the estimates (see the file comment).
+  void restart() noexcept;
+  std::uint32_t warmup() const noexcept { return warmup_; }
 
   double prediction() const noexcept { return yhat_; }
   double simulated() const noexcept { return ysim_; }
@@ -234,6 +259,7 @@ class DeadzoneDeadbandEstimator {
   Side last_ = Side::right, sim_last_ = Side::right;
   std::optional<Side> side1_;
   std::uint32_t run_ = 0;
+  std::uint32_t warmup_ = 0, warm_ = 0;
   double yhat_ = 0.0, ysim_ = 0.0;
   std::uint64_t skipped_ = 0;
 };
@@ -257,6 +283,9 @@ class CoupledCartsEstimator {
   explicit CoupledCartsEstimator(const EstimatorConfig& cfg);
   double step(double v, double y) noexcept;
   void reset() { *this = CoupledCartsEstimator(cfg_); }
+  /// After a gap: clears the signal history (and the open slot crossing), keeps the estimates.
+  void restart() noexcept;
+  std::uint32_t warmup() const noexcept { return warmup_; }
   double prediction() const noexcept { return yhat_; }
   double simulated() const noexcept { return ysim_; }
   /// Velocity model per side (a1, b1, c) and the shared deadband half-width d.
@@ -292,6 +321,7 @@ class CoupledCartsEstimator {
   detail::FitWindow fit_;
   double vel1_ = 0.0, v1_ = 0.0, vraw1_ = 0.0, y1_ = 0.0;
   int dir1_ = 0, dir2_ = 0;
+  std::uint32_t warmup_ = 0, warm_ = 0;
   Side sim_last_ = Side::right;
   double x_ = 0.0, wdot_ = 0.0, w_ = 0.0, ydb_ = 0.0;
   std::uint64_t k_ = 0, stage2_k_ = 0;

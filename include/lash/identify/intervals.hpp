@@ -38,6 +38,7 @@ struct SideIntervals {
 struct IntervalSettings {
   std::size_t sections = 10;      ///< B
   std::size_t min_sections = 5;   ///< fewer identified sections → no interval
+  std::span<const std::size_t> gap_rows;  ///< rows where the record's timestamps jump (restart there)
 };
 
 /// Intervals around `estimate` (the whole-record parameters per side; coupled carts: the shared d

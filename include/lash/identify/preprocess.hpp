@@ -42,6 +42,9 @@ class Preprocessor {
   }
 
   void reset() noexcept;
+  /// Samples after reset() until every output depends on inputs since the reset only (the
+  /// longest path through the filters, difference and delays): the warm-up after a gap.
+  std::size_t memory_samples() const noexcept;
   /// Total delay of the regression output against the raw y [samples] (MA group delay + alignment).
   double output_delay_samples() const noexcept;
 

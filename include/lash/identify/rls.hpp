@@ -67,6 +67,8 @@ class Rls {
   explicit Rls(const RlsConfig<N>& cfg = {}) : cfg_(cfg) {
     cfg_.validate();
     inv_lambda_ = 1.0 / cfg_.lambda;
+    unit_lambda_ = cfg_.lambda == 1.0;
+    for (std::size_t i = 0; i < N; ++i) bounded_ = bounded_ || std::isfinite(cfg_.lower[i]) || std::isfinite(cfg_.upper[i]);
     reset();
   }
 
@@ -111,8 +113,13 @@ class Rls {
       const double scale = tr * inv_lambda_ > cfg_.trace_max ? 1.0 : inv_lambda_;
       const double inv = 1.0 / (cfg_.lambda + r);
       for (std::size_t i = 0; i < N; ++i) eta_[i] += pphi[i] * inv * err;
-      for (std::size_t i = 0; i < N; ++i)
-        for (std::size_t j = i; j < N; ++j) p_[i][j] = p_[i][j] * scale - (pphi[i] * pphi[j] * scale) * inv;
+      if (unit_lambda_) {  // λ = 1: scale = 1 whatever the trace, and x·1 = x exactly
+        for (std::size_t i = 0; i < N; ++i)
+          for (std::size_t j = i; j < N; ++j) p_[i][j] = p_[i][j] - (pphi[i] * pphi[j]) * inv;
+      } else {
+        for (std::size_t i = 0; i < N; ++i)
+          for (std::size_t j = i; j < N; ++j) p_[i][j] = p_[i][j] * scale - (pphi[i] * pphi[j] * scale) * inv;
+      }
     } else {
       // Directional forgetting (Bittanti, Bolzern & Campi 1990; Cao & Schwartz 2000):
       // q = Pφ/(1 + r); P = P − Pφφᵀ P/(β⁻¹ + r), β = λ − (1 − λ)/r; P unchanged when r = 0.
@@ -162,11 +169,16 @@ class Rls {
     const double inv = 1.0 / den;
     const double err = y - yhat;
     for (std::size_t i = 0; i < N; ++i) eta_[i] += pz[i] * inv * err;
-    double tr = 0.0;
-    for (std::size_t i = 0; i < N; ++i) tr += p_[i][i];
-    const double scale = tr * inv_lambda_ > cfg_.trace_max ? 1.0 : inv_lambda_;
-    for (std::size_t i = 0; i < N; ++i)
-      for (std::size_t j = 0; j < N; ++j) p_[i][j] = (p_[i][j] - pz[i] * phip[j] * inv) * scale;
+    if (unit_lambda_) {  // λ = 1: scale = 1 whatever the trace, and x·1 = x exactly
+      for (std::size_t i = 0; i < N; ++i)
+        for (std::size_t j = 0; j < N; ++j) p_[i][j] = p_[i][j] - pz[i] * phip[j] * inv;
+    } else {
+      double tr = 0.0;
+      for (std::size_t i = 0; i < N; ++i) tr += p_[i][i];
+      const double scale = tr * inv_lambda_ > cfg_.trace_max ? 1.0 : inv_lambda_;
+      for (std::size_t i = 0; i < N; ++i)
+        for (std::size_t j = 0; j < N; ++j) p_[i][j] = (p_[i][j] - pz[i] * phip[j] * inv) * scale;
+    }
     project();
     ++updates_;
     return yhat;
@@ -207,12 +219,15 @@ class Rls {
     }
   }
   void project() noexcept {
+    if (!bounded_) return;  // clamping onto (−inf, inf) is the identity (a NaN stays NaN either way)
     for (std::size_t i = 0; i < N; ++i)
       eta_[i] = eta_[i] < cfg_.lower[i] ? cfg_.lower[i] : (eta_[i] > cfg_.upper[i] ? cfg_.upper[i] : eta_[i]);
   }
 
   RlsConfig<N> cfg_;
   double inv_lambda_ = 1.0;
+  bool unit_lambda_ = false;  // λ = 1 (no forgetting): the sample path skips the 1/λ scaling
+  bool bounded_ = false;      // some projection bound is finite
   Vec eta_{};
   Mat p_{};
   std::uint64_t updates_ = 0;
