@@ -290,6 +290,8 @@ MessageCodec::MessageCodec(const dbc::Message& message) : message_(message) {
       const SignalCodec& c = codecs_[i];
       clear_all_[message.signals[i].byte_order == dbc::ByteOrder::motorola ? 1 : 0] |= c.mask_ << c.lo_base_;
     }
+  clear_le_ = clear_all_[0] | __builtin_bswap64(clear_all_[1]);
+  fast_ = packed_ && !has_mux_ && slow_.empty();
 }
 
 bool MessageCodec::selected(std::size_t i, std::span<const std::uint8_t> data, std::span<const double> values) const noexcept {
@@ -321,7 +323,76 @@ inline std::uint64_t load_le(std::span<const std::uint8_t> data, std::size_t siz
 }
 }  // namespace
 
+namespace {
+inline std::uint64_t load_le8(const std::uint8_t* p) noexcept {
+  std::uint64_t w;
+  std::memcpy(&w, p, 8);
+  if constexpr (std::endian::native == std::endian::big) w = __builtin_bswap64(w);
+  return w;
+}
+inline void store_le8(std::uint8_t* p, std::uint64_t w) noexcept {
+  if constexpr (std::endian::native == std::endian::big) w = __builtin_bswap64(w);
+  std::memcpy(p, &w, 8);
+}
+}  // namespace
+
+void MessageCodec::decode_fast(const std::uint8_t* data, double* values) const noexcept {
+  const std::uint64_t le = load_le8(data);
+  const std::uint64_t be = __builtin_bswap64(le);
+  const Lane* const lanes = lanes_.data();
+  const Lane* const mid = lanes + intel_lanes_;
+  const Lane* const end = lanes + codecs_.size();  // fast_: every signal is a lane
+  for (const Lane* l = lanes; l != mid; ++l) {
+    const std::uint64_t raw = (le >> l->lo) & l->mask;
+    values[l->index] = static_cast<double>(static_cast<std::int64_t>((raw ^ l->sign) - l->sign)) * l->factor + l->offset;
+  }
+  for (const Lane* l = mid; l != end; ++l) {
+    const std::uint64_t raw = (be >> l->lo) & l->mask;
+    values[l->index] = static_cast<double>(static_cast<std::int64_t>((raw ^ l->sign) - l->sign)) * l->factor + l->offset;
+  }
+}
+
+namespace {
+/// 1.5·2^52: for |q| < 2^51, q + kMagic rounds q to an integer, ties to even (the FPU's
+/// rounding), and the low bits of its representation hold that integer + 2^51.
+constexpr double kMagic = 6755399441055744.0;
+}  // namespace
+
+bool MessageCodec::encode_fast(const double* values, std::uint8_t* data) const noexcept {
+  // Every lane without a branch; `ok` collects the tests of lane_raw()'s fast path. When
+  // one fails (a clamp, NaN, ±inf, a product near a rounding tie, a field too wide for
+  // this path), nothing is written and encode() takes the per-lane path.
+  const auto lane = [values](const Lane& l, bool& ok) {
+    const double p = values[l.index];
+    const double q = (p - l.offset) * l.inv_factor;
+    const double t = q + kMagic;
+    const double r = t - kMagic;
+    // Integer r from t's bits (no float → int conversion, so none out of range): exact
+    // when |q| < 2^51; a larger |q|, ±inf or NaN gives a raw of magnitude ≥ 2^51 (mod 2^64),
+    // outside every field this path takes (half_tol > 0 only up to 49 bits): the span test fails.
+    const std::uint64_t raw = std::bit_cast<std::uint64_t>(t) - std::bit_cast<std::uint64_t>(kMagic);
+    const double gap = std::fabs(q - r);
+    ok &= (p >= l.min_phys) & (p <= l.max_phys) & (gap < l.half_tol) &
+          (raw - static_cast<std::uint64_t>(l.raw_lo) <= l.raw_span);
+    return (raw & l.mask) << l.lo;
+  };
+  const Lane* const lanes = lanes_.data();
+  const Lane* const mid = lanes + intel_lanes_;
+  const Lane* const end = lanes + codecs_.size();
+  bool ok = true;
+  std::uint64_t s0 = 0, s1 = 0;
+  for (const Lane* l = lanes; l != mid; ++l) s0 |= lane(*l, ok);
+  for (const Lane* l = mid; l != end; ++l) s1 |= lane(*l, ok);
+  if (!ok) [[unlikely]] return false;
+  store_le8(data, (load_le8(data) & ~clear_le_) | s0 | __builtin_bswap64(s1));
+  return true;
+}
+
 bool MessageCodec::decode(std::span<const std::uint8_t> data, std::span<double> values) const noexcept {
+  if (fast_ && data.size() >= 8 && values.size() == codecs_.size()) [[likely]] {
+    decode_fast(data.data(), values.data());
+    return true;
+  }
   if (values.size() != codecs_.size() || data.size() < message_.size) return false;
   if (packed_) {
     const std::uint64_t le = load_le(data, message_.size);
@@ -414,6 +485,12 @@ std::uint32_t MessageCodec::encode_packed(std::span<const double> values, std::u
 
 MessageCodec::EncodeResult MessageCodec::encode(std::span<const double> values, std::span<std::uint8_t> data) noexcept {
   EncodeResult res;
+  if (fast_ && data.size() >= 8 && values.size() == codecs_.size()) [[likely]] {
+    if (encode_fast(values.data(), data.data())) {
+      res.ok = true;
+      return res;
+    }
+  }
   if (values.size() != codecs_.size() || data.size() < message_.size) return res;
   if (has_mux_) {
     // Which signals the multiplexors' encoded values select (multiplexors first).

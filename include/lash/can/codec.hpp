@@ -179,6 +179,13 @@ class MessageCodec {
   std::uint32_t intel_lanes_ = 0;    ///< lanes_[0 .. intel_lanes_) use word 0, the rest word 1
   std::vector<std::uint32_t> slow_;  ///< the other signals of a packed message
   std::uint64_t clear_all_[2] = {0, 0};  ///< bits of every signal per word (messages without multiplexing)
+  /// The fast path: a packed message without multiplexing whose signals are all lanes,
+  /// coded from/into a span of at least 8 bytes (one load, one store, no per-signal branch;
+  /// see encode_fast()).
+  bool fast_ = false;
+  std::uint64_t clear_le_ = 0;  ///< every signal's bits in the little-endian word
+  void decode_fast(const std::uint8_t* data, double* values) const noexcept;
+  bool encode_fast(const double* values, std::uint8_t* data) const noexcept;
   /// Multiplexing: signal i is present when its multiplexor parent_[i] is present and
   /// holds a raw value in ranges_[range_begin_[i] .. range_begin_[i + 1]).
   bool selected(std::size_t i, std::span<const std::uint8_t> data, std::span<const double> values) const noexcept;
