@@ -290,6 +290,52 @@ MessageCodec::MessageCodec(const dbc::Message& message) : message_(message) {
       const SignalCodec& c = codecs_[i];
       clear_all_[message.signals[i].byte_order == dbc::ByteOrder::motorola ? 1 : 0] |= c.mask_ << c.lo_base_;
     }
+  clear_le_ = clear_all_[0] | __builtin_bswap64(clear_all_[1]);
+  build_fast_plan();
+}
+
+namespace {
+/// 1.5·2^52: for |q| < 2^51, q + kMagic rounds q to an integer, ties to even (the FPU's
+/// rounding), and the representation of the sum is bits(kMagic) + that integer.
+constexpr double kMagic = 6755399441055744.0;
+}  // namespace
+
+void MessageCodec::build_fast_plan() {
+  fast_ = packed_ && !has_mux_ && slow_.empty() &&
+          std::all_of(lanes_.begin(), lanes_.end(), [](const Lane& l) { return l.half_tol > 0; });
+  if (!fast_) return;
+  fast_n_ = codecs_.size();
+  bool range = false, tie = false;
+  for (int group = 0; group < 4; ++group) {
+    const bool motorola = group >= 2, sgn = (group & 1) != 0;
+    for (const Lane& l : lanes_) {
+      const SignalCodec& c = codecs_[l.index];
+      if ((l.word == 1) != motorola || c.signed_ != sgn) continue;
+      FastLane f{};
+      f.factor = l.factor;
+      f.offset = l.offset;
+      f.inv_factor = l.inv_factor;
+      f.min_phys = l.min_phys;
+      f.max_phys = l.max_phys;
+      // gap < half_tol  <=>  gap <= tol, so that one min() over all lanes decides (>= 0).
+      f.tol = std::nextafter(l.half_tol, 0.0);
+      f.mask = l.mask;
+      f.above = ~l.mask;
+      f.bias = std::bit_cast<std::uint64_t>(kMagic) + static_cast<std::uint64_t>(l.raw_lo);
+      f.index = l.index;
+      f.lo = l.lo;
+      f.up = static_cast<std::uint8_t>(64 - l.lo - c.length_);
+      f.down = static_cast<std::uint8_t>(64 - c.length_);
+      range = range || c.has_range_;
+      // The product by the reciprocal is the quotient when the factor is a power of two.
+      int e = 0;
+      tie = tie || std::frexp(std::fabs(l.factor), &e) != 0.5;
+      fast_lanes_.push_back(f);
+    }
+    fast_end_[group] = static_cast<std::uint32_t>(fast_lanes_.size());
+  }
+  encode_fast_ = range ? (tie ? &encode_fast<true, true> : &encode_fast<true, false>)
+                       : (tie ? &encode_fast<false, true> : &encode_fast<false, false>);
 }
 
 bool MessageCodec::selected(std::size_t i, std::span<const std::uint8_t> data, std::span<const double> values) const noexcept {
@@ -321,7 +367,65 @@ inline std::uint64_t load_le(std::span<const std::uint8_t> data, std::size_t siz
 }
 }  // namespace
 
-bool MessageCodec::decode(std::span<const std::uint8_t> data, std::span<double> values) const noexcept {
+namespace {
+inline std::uint64_t load_le8(const std::uint8_t* p) noexcept {
+  std::uint64_t w;
+  std::memcpy(&w, p, 8);
+  if constexpr (std::endian::native == std::endian::big) w = __builtin_bswap64(w);
+  return w;
+}
+inline void store_le8(std::uint8_t* p, std::uint64_t w) noexcept {
+  if constexpr (std::endian::native == std::endian::big) w = __builtin_bswap64(w);
+  std::memcpy(p, &w, 8);
+}
+}  // namespace
+
+void MessageCodec::decode_fast(const std::uint8_t* data, double* values) const noexcept {
+  const std::uint64_t le = load_le8(data);
+  const std::uint64_t be = __builtin_bswap64(le);
+  const FastLane* const l = fast_lanes_.data();
+  const auto put = [values](const FastLane& f, std::int64_t raw) {
+    values[f.index] = static_cast<double>(raw) * f.factor + f.offset;
+  };
+  std::uint32_t k = 0;
+  for (; k < fast_end_[0]; ++k) put(l[k], static_cast<std::int64_t>((le >> l[k].lo) & l[k].mask));
+  for (; k < fast_end_[1]; ++k) put(l[k], static_cast<std::int64_t>(le << l[k].up) >> l[k].down);
+  for (; k < fast_end_[2]; ++k) put(l[k], static_cast<std::int64_t>((be >> l[k].lo) & l[k].mask));
+  for (; k < fast_end_[3]; ++k) put(l[k], static_cast<std::int64_t>(be << l[k].up) >> l[k].down);
+}
+
+template <bool Range, bool Tie>
+bool MessageCodec::encode_fast(const MessageCodec& m, const double* values, std::uint8_t* data) noexcept {
+  // Every lane without a branch, then one test: nothing is written, and encode() takes the
+  // per-lane path (lane_raw(), SignalCodec::to_raw()), when a value is NaN or ±inf, outside
+  // [min|max] (Range: some lane has one) or its field, or when the product by the
+  // reciprocal lies within rounding error of a .5 tie (Tie: some factor is no power of two).
+  double margin = std::numeric_limits<double>::infinity();  // must end >= 0
+  std::uint64_t bad = 0;                                     // must end 0
+  const auto lane = [&](const FastLane& f) {
+    const double p = values[f.index];
+    const double q = (p - f.offset) * f.inv_factor;
+    const double t = q + kMagic;
+    if constexpr (Tie) margin = std::min(margin, f.tol - std::fabs(q - (t - kMagic)));
+    // p - min and max - p are >= 0 exactly when p is inside (IEEE subtraction keeps the sign).
+    if constexpr (Range) margin = std::min(margin, std::min(p - f.min_phys, f.max_phys - p));
+    // bits(t) - bias = raw - smallest raw: in the field iff no bit above the mask. A |q| of
+    // 2^51 or more, ±inf or NaN leaves bits far above any field of this path (≤ 49 bits).
+    const auto b = std::bit_cast<std::uint64_t>(t);
+    bad |= (b - f.bias) & f.above;
+    return (b & f.mask) << f.lo;  // bits(kMagic) has no bit below 51: the low bits are raw's
+  };
+  const FastLane* const l = m.fast_lanes_.data();
+  std::uint64_t s0 = 0, s1 = 0;
+  std::uint32_t k = 0;
+  for (; k < m.fast_end_[1]; ++k) s0 |= lane(l[k]);
+  for (; k < m.fast_end_[3]; ++k) s1 |= lane(l[k]);
+  if (bad != 0 || !(margin >= 0.0)) [[unlikely]] return false;
+  store_le8(data, (load_le8(data) & ~m.clear_le_) | s0 | __builtin_bswap64(s1));
+  return true;
+}
+
+bool MessageCodec::decode_general(std::span<const std::uint8_t> data, std::span<double> values) const noexcept {
   if (values.size() != codecs_.size() || data.size() < message_.size) return false;
   if (packed_) {
     const std::uint64_t le = load_le(data, message_.size);
@@ -412,7 +516,7 @@ std::uint32_t MessageCodec::encode_packed(std::span<const double> values, std::u
   return clamped;
 }
 
-MessageCodec::EncodeResult MessageCodec::encode(std::span<const double> values, std::span<std::uint8_t> data) noexcept {
+MessageCodec::EncodeResult MessageCodec::encode_general(std::span<const double> values, std::span<std::uint8_t> data) noexcept {
   EncodeResult res;
   if (values.size() != codecs_.size() || data.size() < message_.size) return res;
   if (has_mux_) {

@@ -12,6 +12,40 @@
 #include "log_formats.hpp"
 
 namespace lash::can {
+
+namespace detail {
+
+void drop(LogReadReport* report, const std::string& file, long line, const std::string& field, const std::string& why) {
+  if (!report) throw InputError(file, static_cast<int>(line), field, why);
+  ++report->dropped;
+  report->problems.push_back(fmt::format("{}:{}: {}: {}", file, line, field, why));
+}
+
+std::size_t split_blank(std::string_view line, std::string_view* out, std::size_t max) {
+  const auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
+  std::size_t n = 0, i = 0;
+  while (i < line.size() && n < max) {
+    while (i < line.size() && blank(line[i])) ++i;
+    if (i >= line.size()) break;
+    std::size_t j = i;
+    while (j < line.size() && !blank(line[j])) ++j;
+    out[n++] = line.substr(i, j - i);
+    i = j;
+  }
+  return n;
+}
+
+std::int64_t days_from_civil(std::int64_t y, unsigned m, unsigned d) {
+  y -= m <= 2;
+  const std::int64_t era = (y >= 0 ? y : y - 399) / 400;
+  const auto yoe = static_cast<unsigned>(y - era * 400);
+  const unsigned doy = (153 * (m + (m > 2 ? -3 : 9)) + 2) / 5 + d - 1;
+  const unsigned doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
+  return era * 146097 + static_cast<std::int64_t>(doe) - 719468;
+}
+
+}  // namespace detail
+
 namespace {
 
 int hex_value(char c) noexcept {
@@ -180,16 +214,6 @@ bool parse_seconds(std::string_view num, double& out, std::string& error) {
   return true;
 }
 
-/// Days since 1970-01-01 of a proleptic Gregorian date (Howard Hinnant's algorithm).
-std::int64_t days_from_civil(std::int64_t y, unsigned m, unsigned d) {
-  y -= m <= 2;
-  const std::int64_t era = (y >= 0 ? y : y - 399) / 400;
-  const auto yoe = static_cast<unsigned>(y - era * 400);
-  const unsigned doy = (153 * (m + (m > 2 ? -3 : 9)) + 2) / 5 + d - 1;
-  const unsigned doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
-  return era * 146097 + static_cast<std::int64_t>(doe) - 719468;
-}
-
 /// "2020-12-19" "12:04:45.485261" (UTC) → seconds since the epoch.
 bool parse_date_time(std::string_view date, std::string_view time, double& out, std::string& error) {
   int y = 0, mo = 0, d = 0, h = 0, mi = 0;
@@ -207,7 +231,7 @@ bool parse_date_time(std::string_view date, std::string_view time, double& out, 
   mi = std::atoi(std::string(time.substr(c1 + 1, c2 - c1 - 1)).c_str());
   double sec = 0;
   if (!parse_seconds(time.substr(c2 + 1), sec, error)) return false;
-  out = static_cast<double>(days_from_civil(y, static_cast<unsigned>(mo), static_cast<unsigned>(d)) * 86400 + h * 3600 + mi * 60) + sec;
+  out = static_cast<double>(detail::days_from_civil(y, static_cast<unsigned>(mo), static_cast<unsigned>(d)) * 86400 + h * 3600 + mi * 60) + sec;
   return true;
 }
 
@@ -374,9 +398,7 @@ std::vector<LogEntry> parse_log(std::string_view text, const std::string& file, 
       e.reset();
     }
     if (!e) {
-      if (!report) throw InputError(file, lineno, "candump line", error);
-      ++report->dropped;
-      report->problems.push_back(fmt::format("{}:{}: {}", file, lineno, error));
+      detail::drop(report, file, lineno, "candump line", error);
     } else {
       out.push_back(std::move(*e));
     }

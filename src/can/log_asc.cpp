@@ -12,26 +12,7 @@
 
 namespace lash::can::detail {
 
-void drop(LogReadReport* report, const std::string& file, long line, const std::string& field, const std::string& why) {
-  if (!report) throw InputError(file, static_cast<int>(line), field, why);
-  ++report->dropped;
-  report->problems.push_back(fmt::format("{}:{}: {}: {}", file, line, field, why));
-}
-
 namespace {
-
-std::size_t split(std::string_view line, std::string_view* out, std::size_t max) {
-  std::size_t n = 0, i = 0;
-  while (i < line.size() && n < max) {
-    while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
-    if (i >= line.size()) break;
-    std::size_t j = i;
-    while (j < line.size() && line[j] != ' ' && line[j] != '\t' && line[j] != '\r') ++j;
-    out[n++] = line.substr(i, j - i);
-    i = j;
-  }
-  return n;
-}
 
 bool iequals(std::string_view a, std::string_view b) {
   if (a.size() != b.size()) return false;
@@ -164,7 +145,7 @@ std::vector<LogEntry> parse_asc(std::string_view text, const std::string& file, 
     const std::string_view line = text.substr(pos, nl - pos);
     pos = nl + 1;
     ++lineno;
-    const std::size_t n = split(line, p, kMax);
+    const std::size_t n = split_blank(line, p, kMax);
     if (n == 0) continue;
     if (iequals(p[0], "base") && n >= 2) {
       if (iequals(p[1], "dec")) base = 10;

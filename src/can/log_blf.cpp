@@ -32,15 +32,6 @@ void put(std::string& d, T v) {
   d.append(reinterpret_cast<const char*>(&v), sizeof(T));
 }
 
-std::int64_t days_from_civil(std::int64_t y, unsigned m, unsigned d) {
-  y -= m <= 2;
-  const std::int64_t era = (y >= 0 ? y : y - 399) / 400;
-  const auto yoe = static_cast<unsigned>(y - era * 400);
-  const unsigned doy = (153 * (m + (m > 2 ? -3 : 9)) + 2) / 5 + d - 1;
-  const unsigned doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
-  return era * 146097 + static_cast<std::int64_t>(doe) - 719468;
-}
-
 /// SYSTEMTIME (year, month, weekday, day, hour, minute, second, ms) → seconds; 0 if not a date.
 double systemtime(std::string_view d, std::size_t at) {
   std::uint16_t s[8];
@@ -88,6 +79,33 @@ std::uint8_t fd_dlc(unsigned len) {
   for (std::uint8_t d = 0; d < 16; ++d)
     if (fd_len(d) >= len) return d;
   return 15;
+}
+
+/// The common part of CAN_FD_MESSAGE and CAN_FD_MESSAGE_64: flags, then `valid` data bytes
+/// from `data` (the rest of the object); a remote frame's length is `remote_len`.
+/// False (a reported drop) when the bytes do not fit the object or a classic frame.
+bool fd_payload(Frame& f, bool remote, bool fd, bool brs, bool esi, unsigned remote_len, unsigned valid,
+                std::string_view data, LogReadReport* report, const std::string& file, std::size_t pos) {
+  f.remote = remote;
+  f.fd = fd;
+  f.brs = brs;
+  f.esi = esi;
+  if (valid > 64 || valid > data.size() || (!fd && valid > 8)) {
+    drop(report, file, static_cast<long>(pos), "valid bytes", fmt::format("{} data bytes do not fit the object", valid));
+    return false;
+  }
+  f.len = static_cast<std::uint8_t>(remote ? remote_len : valid);
+  std::memcpy(f.data.data(), data.data(), valid);
+  return true;
+}
+
+/// The first 16 bytes of every object: signature, header size, header version 1, size, type.
+void put_object_base(std::string& d, std::uint16_t header_size, std::uint32_t object_size, std::uint32_t type) {
+  d.append("LOBJ", 4);
+  put<std::uint16_t>(d, header_size);
+  put<std::uint16_t>(d, 1);
+  put<std::uint32_t>(d, object_size);
+  put<std::uint32_t>(d, type);
 }
 
 /// Parses the objects of the concatenated container payloads.
@@ -175,18 +193,12 @@ void parse_objects(std::string_view d, double start, const std::string& file, Lo
       const auto dlc = get<std::uint8_t>(d, p + 3);
       id = get<std::uint32_t>(d, p + 4);
       const auto fdf = get<std::uint8_t>(d, p + 13);
-      const auto valid = get<std::uint8_t>(d, p + 14);
-      f.remote = (flags & 0x80) != 0;
-      f.fd = (fdf & 1) != 0;
-      f.brs = (fdf & 2) != 0;
-      f.esi = (fdf & 4) != 0;
-      if (valid > 64 || (!f.fd && valid > 8)) {
-        drop(report, file, static_cast<long>(pos), "valid bytes", fmt::format("{} data bytes", valid));
+      const bool fd = (fdf & 1) != 0;
+      if (!fd_payload(f, (flags & 0x80) != 0, fd, (fdf & 2) != 0, (fdf & 4) != 0, fd ? fd_len(dlc) : dlc,
+                      get<std::uint8_t>(d, p + 14), d.substr(p + 20, next - (p + 20)), report, file, pos)) {
         pos = next;
         continue;
       }
-      f.len = f.remote ? static_cast<std::uint8_t>(f.fd ? fd_len(dlc) : dlc) : valid;
-      std::memcpy(f.data.data(), d.data() + p + 20, valid);
     } else if (type == kCanFd64) {
       if (!need(40)) {
         pos = next;
@@ -194,20 +206,13 @@ void parse_objects(std::string_view d, double start, const std::string& file, Lo
       }
       channel = get<std::uint8_t>(d, p);
       const auto dlc = get<std::uint8_t>(d, p + 1);
-      const auto valid = get<std::uint8_t>(d, p + 2);
       id = get<std::uint32_t>(d, p + 4);
       const auto fdf = get<std::uint32_t>(d, p + 12);
-      f.remote = (fdf & 0x10) != 0;
-      f.fd = (fdf & 0x1000) != 0;
-      f.brs = (fdf & 0x2000) != 0;
-      f.esi = (fdf & 0x4000) != 0;
-      if (valid > 64 || p + 40 + valid > next || (!f.fd && valid > 8)) {
-        drop(report, file, static_cast<long>(pos), "valid bytes", fmt::format("{} data bytes do not fit the object", valid));
+      if (!fd_payload(f, (fdf & 0x10) != 0, (fdf & 0x1000) != 0, (fdf & 0x2000) != 0, (fdf & 0x4000) != 0, fd_len(dlc),
+                      get<std::uint8_t>(d, p + 2), d.substr(p + 40, next - (p + 40)), report, file, pos)) {
         pos = next;
         continue;
       }
-      f.len = f.remote ? fd_len(dlc) : valid;
-      std::memcpy(f.data.data(), d.data() + p + 40, valid);
     } else {
       pos = next;  // not a CAN frame (markers, statistics, other buses)
       continue;
@@ -339,11 +344,7 @@ void write_blf(std::ostream& os, const std::vector<LogEntry>& entries) {
     }
     const double rel = f.timestamp_s - start;
     const auto ns = static_cast<std::uint64_t>(rel > 0 ? rel * 1e9 + 0.5 : 0.0);
-    objs.append("LOBJ", 4);
-    put<std::uint16_t>(objs, 32);
-    put<std::uint16_t>(objs, 1);
-    put<std::uint32_t>(objs, static_cast<std::uint32_t>(32 + body.size()));
-    put<std::uint32_t>(objs, type);
+    put_object_base(objs, 32, static_cast<std::uint32_t>(32 + body.size()), type);
     put<std::uint32_t>(objs, 2);  // TIME_ONE_NANS
     put<std::uint16_t>(objs, 0);
     put<std::uint16_t>(objs, 0);
@@ -360,11 +361,7 @@ void write_blf(std::ostream& os, const std::vector<LogEntry>& entries) {
     compress2(reinterpret_cast<Bytef*>(z.data()), &zn, reinterpret_cast<const Bytef*>(objs.data() + at), static_cast<uLong>(n), 6);
     z.resize(zn);
     const auto size = static_cast<std::uint32_t>(32 + z.size());
-    file.append("LOBJ", 4);
-    put<std::uint16_t>(file, 16);
-    put<std::uint16_t>(file, 1);
-    put<std::uint32_t>(file, size);
-    put<std::uint32_t>(file, kLogContainer);
+    put_object_base(file, 16, size, kLogContainer);
     put<std::uint16_t>(file, 2);
     file.append(6, '\0');
     put<std::uint32_t>(file, static_cast<std::uint32_t>(n));

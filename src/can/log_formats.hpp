@@ -1,5 +1,7 @@
 #pragma once
 // Readers and writers of the vendor log formats behind can::read_log / write_log.
+#include <cstddef>
+#include <cstdint>
 #include <ostream>
 #include <string>
 #include <string_view>
@@ -16,7 +18,14 @@ void write_trc(std::ostream& out, const std::vector<LogEntry>& entries);
 std::vector<LogEntry> parse_blf(std::string_view bytes, const std::string& file, LogReadReport* report);
 void write_blf(std::ostream& out, const std::vector<LogEntry>& entries);
 
-/// Records one bad line/object: InputError without a report, a counted drop with one.
+/// Records one bad line/object: InputError without a report, a counted drop with one
+/// (its problem text is "file:line: field: why"; `line` is a byte offset for BLF).
 void drop(LogReadReport* report, const std::string& file, long line, const std::string& field, const std::string& why);
+
+/// Splits `line` on blanks (space, tab, CR) into at most `max` fields; returns how many.
+std::size_t split_blank(std::string_view line, std::string_view* out, std::size_t max);
+
+/// Days since 1970-01-01 of a proleptic Gregorian date (Howard Hinnant's algorithm).
+std::int64_t days_from_civil(std::int64_t y, unsigned m, unsigned d);
 
 }  // namespace lash::can::detail

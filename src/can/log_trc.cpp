@@ -14,19 +14,6 @@
 namespace lash::can::detail {
 namespace {
 
-std::size_t split_blank(std::string_view line, std::string_view* out, std::size_t max) {
-  std::size_t n = 0, i = 0;
-  while (i < line.size() && n < max) {
-    while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
-    if (i >= line.size()) break;
-    std::size_t j = i;
-    while (j < line.size() && line[j] != ' ' && line[j] != '\t' && line[j] != '\r') ++j;
-    out[n++] = line.substr(i, j - i);
-    i = j;
-  }
-  return n;
-}
-
 bool hex(std::string_view s, std::uint32_t& v) {
   if (s.empty() || s.size() > 8) return false;
   auto r = std::from_chars(s.data(), s.data() + s.size(), v, 16);

@@ -97,7 +97,7 @@ expect "$r1 $r2 $r3 $r4" "2 2 2 2"
 printf '(1.000000) can0 100#00\n(2.000000) can0 100#0\n(3.000000) can0 7AB#00\n' > "$tmp/bad.log"
 $L can decode --dbc "$DBC" "$tmp/bad.log" > "$tmp/dec.txt" 2>"$tmp/err"
 expect "$(wc -l < "$tmp/dec.txt")" 2
-grep -q "dropped: .*bad.log:2: bad hex data" "$tmp/err" || fail "log drop: $(cat "$tmp/err")"
+grep -q "dropped: .*bad.log:2: candump line: bad hex data" "$tmp/err" || fail "log drop: $(cat "$tmp/err")"
 grep -q "1 of 3 records of .*bad.log dropped" "$tmp/err" || fail "log drop count: $(cat "$tmp/err")"
 # A file that is no log at all: exit 2.
 printf 'not a blf' > "$tmp/x.blf"

@@ -133,7 +133,13 @@ class MessageCodec {
   /// signals not selected (by their multiplexor's raw value, through every level of
   /// extended multiplexing) come out as NaN.
   /// False (values untouched) when a span is too short.
-  bool decode(std::span<const std::uint8_t> data, std::span<double> values) const noexcept;
+  bool decode(std::span<const std::uint8_t> data, std::span<double> values) const noexcept {
+    if (fast_ && data.size() >= 8 && values.size() == fast_n_) [[likely]] {
+      decode_fast(data.data(), values.data());
+      return true;
+    }
+    return decode_general(data, values);
+  }
 
   struct EncodeResult {
     bool ok = false;            ///< false: a span was too short, nothing written
@@ -142,7 +148,11 @@ class MessageCodec {
   /// Encodes `values` (size == signal_count()) into `data` (size ≥ message size).
   /// Multiplexed signals are written only when the multiplexor's encoded value
   /// selects them; NaN values of multiplexed signals are skipped too.
-  EncodeResult encode(std::span<const double> values, std::span<std::uint8_t> data) noexcept;
+  EncodeResult encode(std::span<const double> values, std::span<std::uint8_t> data) noexcept {
+    if (fast_ && data.size() >= 8 && values.size() == fast_n_) [[likely]]
+      if (encode_fast_(*this, values.data(), data.data())) return {true, 0};
+    return encode_general(values, data);
+  }
   /// Clamps counted over this codec's lifetime.
   std::uint64_t clamp_count() const noexcept { return clamp_count_; }
   /// True when the message fits 8 bytes and uses the one-word path (see codec.cpp).
@@ -179,6 +189,35 @@ class MessageCodec {
   std::uint32_t intel_lanes_ = 0;    ///< lanes_[0 .. intel_lanes_) use word 0, the rest word 1
   std::vector<std::uint32_t> slow_;  ///< the other signals of a packed message
   std::uint64_t clear_all_[2] = {0, 0};  ///< bits of every signal per word (messages without multiplexing)
+  /// The fast path (a plan built at construction): a packed message without multiplexing
+  /// whose signals are all integer lanes of at most 48 bits (49 signed), coded from/into a
+  /// span of at least 8 bytes with one load and one store. Decoding: each lane is a shift
+  /// and a mask (unsigned) or an arithmetic shift pair (signed) of the little- or big-endian
+  /// word, in four groups (no per-lane flag), scaled. Encoding: every lane without a branch,
+  /// and one test per message (see encode_fast()); on any doubt the per-lane path decides.
+  struct FastLane {
+    double factor, offset, inv_factor, min_phys, max_phys;
+    double tol;            ///< largest |q - round(q)| that cannot hide a tie (see lane_raw); < 0: none
+    std::uint64_t mask;    ///< low `length` bits
+    std::uint64_t above;   ///< ~mask
+    std::uint64_t bias;    ///< bits of kMagic + smallest raw (see encode_fast)
+    std::uint32_t index;   ///< signal index
+    std::uint8_t lo;       ///< LSB position in the word
+    std::uint8_t up, down; ///< decode of a signed lane: (word << up) >> down, arithmetic
+  };
+  using EncodeFastFn = bool (*)(const MessageCodec&, const double*, std::uint8_t*) noexcept;
+  template <bool Range, bool Tie>
+  static bool encode_fast(const MessageCodec& m, const double* values, std::uint8_t* data) noexcept;
+  void build_fast_plan();
+  void decode_fast(const std::uint8_t* data, double* values) const noexcept;
+  bool decode_general(std::span<const std::uint8_t> data, std::span<double> values) const noexcept;
+  EncodeResult encode_general(std::span<const double> values, std::span<std::uint8_t> data) noexcept;
+  bool fast_ = false;
+  std::size_t fast_n_ = 0;          ///< signal count (the fast path's values size)
+  std::vector<FastLane> fast_lanes_;  ///< Intel unsigned, Intel signed, Motorola unsigned, Motorola signed
+  std::uint32_t fast_end_[4] = {0, 0, 0, 0};  ///< end of each group in fast_lanes_
+  EncodeFastFn encode_fast_ = nullptr;
+  std::uint64_t clear_le_ = 0;  ///< every signal's bits in the little-endian word
   /// Multiplexing: signal i is present when its multiplexor parent_[i] is present and
   /// holds a raw value in ranges_[range_begin_[i] .. range_begin_[i + 1]).
   bool selected(std::size_t i, std::span<const std::uint8_t> data, std::span<const double> values) const noexcept;
