@@ -57,6 +57,11 @@ int run_closed_loop_scenario_cmd(const std::string& path, const std::string& com
                        {"estimator_reason", r.estimator_reason},
                        {"dither_amplitude", s.adaptation.dither_amplitude},
                        {"dither_period_s", s.adaptation.dither_period_s}};
+    if (r.bench) {  // valve: the bench's figures before and after the first drift too
+      const auto b = nlohmann::json::parse(hil::scenario_json(*r.bench));
+      for (const char* k : {"tracking_before_drift", "tracking_after_drift"})
+        if (b.contains(k)) j[k] = b[k];
+    }
     fmt::print("{}\n", j.dump());
     return kExitOk;
   }

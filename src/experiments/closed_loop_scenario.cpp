@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "lash/hil/node_run.hpp"
+#include "lash/hil/simulate.hpp"
 #include "lash/identify/config_file.hpp"
 #include "lash/io/error.hpp"
 #include "lash/io/toml_util.hpp"
@@ -266,6 +268,40 @@ void record(ClosedLoopScenarioTrace& tr, double t, double r, double y, double cm
 
 }  // namespace
 
+void apply_to_bench(const ClosedLoopScenario& s, CompensationMode mode, hil::BenchSettings& b) {
+  if (s.rig != rigs::RigKind::pilot_valve)
+    throw InputError(s.file, 0, "rig",
+                     std::string("the HIL bench is the pilot valve (pressure control); a '") + rigs::to_string(s.rig) +
+                         "' scenario runs in `lash closed-loop --scenario` only");
+  if (s.command_min < -2000.0 || s.command_max > 2000.0)
+    throw InputError(s.file, 0, s.command_min < -2000.0 ? "controller.min" : "controller.max",
+                     "the bench drives each solenoid with 0..2000 mA: [controller] min and max must lie in "
+                     "-2000..2000 [mA]");
+  b.set_step(s.dt_s);
+  hil::BenchScenario h;
+  h.file = s.file;
+  h.mode = mode;
+  h.plant.params = s.rig_config.pilot_valve;
+  h.plant.seed = s.seed;
+  for (const Drift& d : s.drift)
+    h.plant.drift.push_back({static_cast<std::uint32_t>(step_of(d.at_s, s.dt_s)), d.after.pilot_valve});
+  h.law.pid = s.pid;
+  h.law.pid.dt_s = s.dt_s;
+  h.law.feedforward = s.feedforward;
+  h.law.command_min = s.command_min;
+  h.law.command_max = s.command_max;
+  h.law.compensation.mode = mode;
+  h.law.compensation.nominal = s.deadzone;
+  h.law.compensation.estimator = s.estimator;
+  h.law.compensation.adaptation = s.adaptation;
+  h.reference = s.reference;
+  h.duration_s = s.duration_s;
+  h.score_t0_s = s.score_t0_s;
+  h.score_t1_s = s.score_t1_s;
+  h.first_drift_s = s.drift.empty() ? -1.0 : static_cast<double>(step_of(s.drift.front().at_s, s.dt_s)) * s.dt_s;
+  b.scenario = std::move(h);
+}
+
 ClosedLoopScenarioResult run_closed_loop_scenario(const ClosedLoopScenario& s, CompensationMode mode) {
   ClosedLoopScenarioResult res;
   res.mode = mode;
@@ -280,36 +316,28 @@ ClosedLoopScenarioResult run_closed_loop_scenario(const ClosedLoopScenario& s, C
     return next_drift < s.drift.size() && static_cast<std::int64_t>(k) >= step_of(s.drift[next_drift].at_s, dt);
   };
   if (s.rig == rigs::RigKind::pilot_valve) {
-    DeadzoneCompensationConfig cc;
-    cc.mode = mode;
-    cc.nominal = s.deadzone;
-    cc.estimator = s.estimator;
-    cc.adaptation = s.adaptation;
-    DeadzoneCompensator comp(cc);
-    rigs::PilotValveRig rig(s.rig_config.pilot_valve, dt, s.seed);
-    double y = rig.initial_output();
-    double p_true = rig.true_pressure_kPa();
-    for (std::size_t k = 0; k < n; ++k) {
-      const double t = static_cast<double>(k) * dt;
-      while (drift_due(k)) rig.set_params(s.drift[next_drift++].after.pilot_valve);
-      const double r = ref.next();
-      const double u = pid.step(r - y) + s.feedforward * r;
-      const double i = clamp(comp.command(u), s.command_min, s.command_max);
-      comp.observe(i, y);
-      const bool on = mode != CompensationMode::none;
-      record(res.trace, t, r, p_true, i, on ? comp.inverse().params().offset_right : 0.0,
-             on ? -comp.inverse().params().offset_left : 0.0);
-      score.add(t, r - p_true);
-      y = rig.step(i);
-      p_true = rig.true_pressure_kPa();
+    // One engine: the bench's nodes over the in-process link (what `lash hil run` runs).
+    hil::BenchSettings b;
+    apply_to_bench(s, mode, b);
+    const hil::BenchLayout L;  // the layout of config/hydraulic_bench.dbc
+    const hil::SimulationResult sim =
+        hil::simulate_bench(L, hil::master_config(b, ""), hil::slave_config(b, L), n);
+    for (std::size_t m = 0; m < n && m + 1 < sim.master.size() && m < sim.slave.size(); ++m) {
+      const auto& ml = sim.master[m + 1];  // master row 0 is the CONNECT step
+      record(res.trace, static_cast<double>(m) * dt, ml.reference_kPa, sim.slave[m].pressure_kPa, ml.current_mA,
+             ml.inverse_right_mA, ml.inverse_left_mA);
     }
-    res.final_right = mode == CompensationMode::none ? 0.0 : comp.inverse().params().offset_right;
-    res.final_left = mode == CompensationMode::none ? 0.0 : -comp.inverse().params().offset_left;
-    res.updates = comp.updates();
-    res.reason = comp.reason();
-    res.estimator_identified = comp.estimator().params(Side::right).identified && comp.estimator().params(Side::left).identified;
-    res.estimator_reason = std::string("right: ") + comp.estimator_reason(Side::right) +
-                           "; left: " + comp.estimator_reason(Side::left);
+    res.bench = hil::scenario_figures(*b.scenario, dt, sim.master, sim.slave, sim.compensation);
+    const hil::CompensationState& c = sim.compensation;
+    res.rms_error = res.bench->window.rms_error;
+    res.max_abs_error = res.bench->window.max_abs_error;
+    res.final_right = c.right;
+    res.final_left = c.left;
+    res.updates = c.updates;
+    res.reason = c.reason;
+    res.estimator_identified = c.estimator_identified;
+    res.estimator_reason = c.estimator_reason;
+    return res;
   } else {
     BacklashCompensationConfig cc;
     cc.mode = mode;

@@ -146,6 +146,7 @@ std::vector<std::string> loop_args(const LoopOptions& l, const SessionOptions& o
   if (!l.hold_dma_latency) a.push_back("--no-dma-latency");
   a.insert(a.end(), {"--overrun-policy", l.policy == rt::OverrunPolicy::stop ? "stop" : "tolerate",
                      "--max-overruns", std::to_string(l.max_overruns)});
+  a.insert(a.end(), o.node_args.begin(), o.node_args.end());
   return a;
 }
 
@@ -327,7 +328,8 @@ RunReport Session::run(const std::function<void(const std::string&)>& progress) 
   std::vector<MasterStepLog> simulated;
   if (have_master && mrun.stats.control_steps > 0)
     simulated = simulate_bench(L, mc, sc, static_cast<std::size_t>(mrun.stats.control_steps)).master;
-  make_run_report(rep, have_master ? &mrun : nullptr, sruns, simulated);
+  make_run_report(rep, have_master ? &mrun : nullptr, sruns, simulated,
+                  o_.settings.scenario ? &*o_.settings.scenario : nullptr);
   AtomicFile f(dir / "report.json");
   f.stream() << run_report_json(rep);
   f.commit();
