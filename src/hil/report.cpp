@@ -133,8 +133,8 @@ ScenarioFigures scenario_figures(const BenchScenario& s, double dt_s, const std:
   f.file = s.file;
   f.mode = s.mode;
   f.window = tracking(ref, y, dt_s, s.score_t0_s, s.score_t1_s);
-  if (s.first_drift_s >= 0) {
-    const double end = static_cast<double>(std::min(ref.size(), y.size())) * dt_s;
+  const double end = static_cast<double>(std::min(ref.size(), y.size())) * dt_s;
+  if (s.first_drift_s >= 0 && s.first_drift_s < end) {
     // [0, drift): the last sample before the drift's control step.
     const double before_end = static_cast<double>(std::llround(s.first_drift_s / dt_s) - 1) * dt_s;
     f.before_drift = tracking(ref, y, dt_s, 0.0, before_end);
@@ -304,7 +304,8 @@ std::string run_report_json(const RunReport& r) {
     out["off_schedule_steps"] = r.off_schedule;
   }
   if (r.scenario) {  // the keys of `lash closed-loop --json` (scenario_json)
-    for (auto& [k, v] : json::parse(scenario_json(*r.scenario)).items()) out[k] = v;
+    const json sj = json::parse(scenario_json(*r.scenario));
+    for (auto& [k, v] : sj.items()) out[k] = v;
   }
   out["out_dir"] = r.out_dir;
   return out.dump(2) + "\n";
