@@ -76,6 +76,18 @@ for attempt in range(3):
           f"final {rep['compensation']['final']}, updates {rep['adaptation']['updates']}, master TET mean "
           f"{rep['master']['tet_us']['mean']:.3f} us")
     check(rep["master"]["control_steps"] == 8000, "hil run: the scenario's 40 s at 5 ms")
+    # Steps that consumed another frame than their own (hil_run.py): the traces may differ from
+    # the simulation, but never before the first of them.
+    m = hil_netns.read_csv(os.path.join(out, "master.csv"))
+    s = hil_netns.read_csv(os.path.join(out, "slave.csv"))
+    off = [int(cs) for cs, sc, fr in zip(m["control_step"], m["sensor_counter"], m["sensor_fresh"])
+           if cs >= 0 and (fr == 0 or int(sc) != int(cs) % 65536)]
+    off += [int(st) for st, cc, fr in zip(s["step"], s["command_counter"], s["command_fresh"])
+            if 0 < st < 8000 and (fr == 0 or int(cc) != int(st) - 1)]
+    check(rep["off_schedule_steps"] == len(set(off)), "off_schedule_steps as recomputed from the logs")
+    if off and rep["max_abs_diff_vs_simulation_kPa"] > 0:
+        check(min(off) <= rep["first_diff_control_step"],
+              f"first difference (step {rep['first_diff_control_step']}) not before the first off-schedule step {min(off)}")
     if rep["off_schedule_steps"] == 0:
         clean = rep
         break
@@ -117,7 +129,6 @@ for attempt in range(3):
         clean_default = True
         check(r0 == 500 and r1 == 1500, "default reference: the 500 -> 1500 kPa step")
         check(overshoot <= 10.0, f"live default loop: overshoot {overshoot:.2f} % <= 10 %")
-        check(abs(overshoot - rep["step_response"]["overshoot_pct"]) < 1e-6, "overshoot = report's")
         check(sd <= 50.0, f"live default loop: current std {sd:.2f} mA <= 50 mA")
         break
 if not clean_default:
