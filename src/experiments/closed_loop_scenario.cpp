@@ -242,16 +242,6 @@ namespace {
 
 double clamp(double x, double lo, double hi) noexcept { return x < lo ? lo : (x > hi ? hi : x); }
 
-struct Score {
-  double t0, t1, sum2 = 0.0, max_abs = 0.0;
-  std::size_t n = 0;
-  void add(double t, double e) noexcept {
-    if (t < t0 - 1e-12 || t > t1 + 1e-12) return;
-    sum2 += e * e;
-    max_abs = std::max(max_abs, std::fabs(e));
-    ++n;
-  }
-};
 
 void reserve(ClosedLoopScenarioTrace& tr, std::size_t n) {
   for (auto* v : {&tr.t_s, &tr.reference, &tr.output, &tr.command, &tr.param_right, &tr.param_left}) v->reserve(n);
@@ -310,7 +300,6 @@ ClosedLoopScenarioResult run_closed_loop_scenario(const ClosedLoopScenario& s, C
   reserve(res.trace, n);
   Signal ref(s.reference, dt);
   Pid pid(s.pid);
-  Score score{s.score_t0_s, s.score_t1_s};
   std::size_t next_drift = 0;
   auto drift_due = [&](std::size_t k) {
     return next_drift < s.drift.size() && static_cast<std::int64_t>(k) >= step_of(s.drift[next_drift].at_s, dt);
@@ -366,7 +355,6 @@ ClosedLoopScenarioResult run_closed_loop_scenario(const ClosedLoopScenario& s, C
       const bool on = mode != CompensationMode::none;
       record(res.trace, t, r, y, v, on ? comp.inverse().params().right : 0.0, on ? comp.inverse().params().left : 0.0);
       res.trace.drive.push_back(w);
-      score.add(t, r - y);
       rig.step(v);
       y = rig.free_position_m();
       w = rig.motor_position_m();
@@ -378,8 +366,9 @@ ClosedLoopScenarioResult run_closed_loop_scenario(const ClosedLoopScenario& s, C
     res.estimator_identified = comp.estimator().identified();
     res.estimator_reason = comp.estimator_reason();
   }
-  res.rms_error = score.n ? std::sqrt(score.sum2 / static_cast<double>(score.n)) : std::nan("");
-  res.max_abs_error = score.max_abs;
+  const hil::Tracking w = hil::tracking(res.trace.reference, res.trace.output, dt, s.score_t0_s, s.score_t1_s);
+  res.rms_error = w.rms_error;
+  res.max_abs_error = w.max_abs_error;
   return res;
 }
 
