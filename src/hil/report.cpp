@@ -134,11 +134,11 @@ ScenarioFigures scenario_figures(const BenchScenario& s, double dt_s, const std:
   f.mode = s.mode;
   f.window = tracking(ref, y, dt_s, s.score_t0_s, s.score_t1_s);
   const double end = static_cast<double>(std::min(ref.size(), y.size())) * dt_s;
-  if (s.first_drift_s >= 0 && s.first_drift_s < end) {
+  if (s.first_drift_s >= 0) {  // a run that ended before the drift has no "after"
     // [0, drift): the last sample before the drift's control step.
     const double before_end = static_cast<double>(std::llround(s.first_drift_s / dt_s) - 1) * dt_s;
     f.before_drift = tracking(ref, y, dt_s, 0.0, before_end);
-    f.after_drift = tracking(ref, y, dt_s, s.first_drift_s, end);
+    if (s.first_drift_s < end) f.after_drift = tracking(ref, y, dt_s, s.first_drift_s, end);
   }
   f.compensation = compensation;
   return f;
