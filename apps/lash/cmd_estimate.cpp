@@ -85,6 +85,10 @@ int run(const EstimateOptions& o) {
   (void)assemble(o, model, preset, nullptr, job);
 
   const Record rec = load_record(o.data, job.columns, o.strict);
+  if (!o.nrmse_window.empty() && !rec.t().empty() && job.nrmse_t0_s >= rec.t().back())
+    throw InputError(o.data, 0, "--nrmse-window",
+                     "T0 = " + format_double(job.nrmse_t0_s) + " s is not before the record's end (" +
+                         format_double(rec.t().back()) + " s)");
   EstimatorConfig cfg = assemble(o, model, preset, &rec, job);
   cfg.fit_start_s = job.nrmse_t0_s;  // the verdict's fit window starts where the reported NRMSE's does
   const bool keep = !o.out.empty() || !o.plot.empty();

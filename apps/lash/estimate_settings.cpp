@@ -1,5 +1,6 @@
 #include "estimate_settings.hpp"
 
+#include <cmath>
 #include <stdexcept>
 
 #include "cli_common.hpp"
@@ -82,8 +83,9 @@ EstimatorConfig assemble(const EstimateOptions& o, ModelKind model, Preset prese
   }
   if (!o.columns.empty()) job.columns = split_names(o.columns);
   if (!o.nrmse_window.empty()) {
-    if (o.nrmse_window.size() != 2 || !(o.nrmse_window[0] < o.nrmse_window[1]))
-      throw InputError("", 0, "--nrmse-window", "expected T0 T1 with T0 < T1 [s]");
+    if (o.nrmse_window.size() != 2 || !(o.nrmse_window[0] >= 0) || !(o.nrmse_window[0] < o.nrmse_window[1]) ||
+        !std::isfinite(o.nrmse_window[1]))
+      throw InputError("", 0, "--nrmse-window", "expected T0 T1 with 0 <= T0 < T1, finite [s]");
     job.nrmse_t0_s = o.nrmse_window[0];
     job.nrmse_t1_s = o.nrmse_window[1];
   }
