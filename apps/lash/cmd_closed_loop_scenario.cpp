@@ -65,6 +65,11 @@ int run_closed_loop_scenario_cmd(const std::string& path, const std::string& com
                                     {"guess_right", e.guess_right},
                                     {"guess_left", e.guess_left}};
     if (!valve) j["adaptation"]["estimator"]["input_shift"] = s.backlash_estimator.input_shift;
+    if (r.bench) {  // valve: the bench's figures before and after the first drift too
+      const auto b = nlohmann::json::parse(hil::scenario_json(*r.bench));
+      for (const char* k : {"tracking_before_drift", "tracking_after_drift"})
+        if (b.contains(k)) j[k] = b[k];
+    }
     fmt::print("{}\n", j.dump());
     return kExitOk;
   }

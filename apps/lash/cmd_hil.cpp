@@ -12,6 +12,7 @@
 
 #include <fmt/core.h>
 
+#include "lash/experiments/closed_loop_scenario.hpp"
 #include "lash/io/csv.hpp"
 
 namespace lash::cli::hilcli {
@@ -38,6 +39,15 @@ void add_common(CLI::App* sub, CommonOptions& o) {
       ->check(CLI::Range(std::size_t{1}, std::size_t{1000000}));
 }
 
+void add_scenario(CLI::App* sub, CommonOptions& o) {
+  sub->add_option("--scenario", o.scenario,
+                  "Closed-loop scenario TOML of the pilot valve (docs/compensation.md): the slave runs its rig and "
+                  "drifts, the master its controller, compensation and reference (--reference is ignored)");
+  sub->add_option("--compensation", o.compensation, "With --scenario: none | fixed | adaptive")
+      ->check(CLI::IsMember({"none", "fixed", "adaptive"}))
+      ->each([&o](const std::string&) { o.compensation_given = true; });
+}
+
 CLI::Option* add_duration(CLI::App* sub, double& value, const std::string& what) {
   const double max_s = static_cast<double>(hil::kMaxSteps) * 5e-3;
   return sub
@@ -60,6 +70,15 @@ hil::BenchSettings load_settings(const CommonOptions& o) {
       throw InputError("", 0, "--step-ms", "must be in " + format_double(hil::kMinStepMs) + ".." +
                                                format_double(hil::kMaxStepMs) + " [ms]");
     s.set_step(o.step_ms * 1e-3);
+  }
+  if (o.compensation_given && o.scenario.empty())
+    throw InputError("", 0, "--compensation", "needs --scenario (the bench's own controller has its fixed offset)");
+  if (!o.scenario.empty()) {
+    const experiments::ClosedLoopScenario sc = experiments::load_closed_loop_scenario(o.scenario);
+    if (o.step_ms != 0.0 && std::fabs(o.step_ms * 1e-3 - sc.dt_s) > 1e-9 * sc.dt_s)
+      throw InputError("", 0, "--step-ms", "the scenario " + o.scenario + " runs at its dt_s = " +
+                                               format_double(sc.dt_s * 1e3) + " ms; drop --step-ms");
+    experiments::apply_to_bench(sc, parse_compensation_mode(o.compensation.c_str()), s);
   }
   return s;
 }

@@ -20,10 +20,15 @@ struct CommonOptions {
   bool no_dma_latency = false;
   std::string overrun_policy = "tolerate";
   std::size_t max_overruns = 10;
+  std::string scenario;                  // --scenario: a closed-loop scenario on the bench
+  std::string compensation = "adaptive"; // --compensation (with --scenario)
+  bool compensation_given = false;
 };
 
 void add_common(CLI::App* sub, CommonOptions& o);
-/// The settings file (default config/hil/bench.toml) with --bus and --step-ms applied.
+/// --scenario FILE.toml and --compensation none|fixed|adaptive (run, simulate, slave, master).
+void add_scenario(CLI::App* sub, CommonOptions& o);
+/// The settings file (default config/hil/bench.toml) with --bus, --step-ms and --scenario applied.
 hil::BenchSettings load_settings(const CommonOptions& o);
 /// Validated loop options (InputError naming the option).
 hil::LoopOptions loop_options(const CommonOptions& o, const hil::BenchSettings& s);

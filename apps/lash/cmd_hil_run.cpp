@@ -19,6 +19,7 @@ struct RunOptions {
   std::string reference = "step:from=500,to=1500,time=1";
   std::string out_dir = "hil-out";
   bool json_out = false;
+  bool duration_given = false;
   bool no_isolate = false;
   bool restart_slave = false;
   std::int64_t seed = -1;
@@ -32,8 +33,25 @@ struct SimulateOptions {
   std::string reference = "step:from=500,to=1500,time=1";
   std::int64_t seed = -1;
   std::string out = "hil_sim.csv";
+  CommonOptions scenario;  // --scenario, --compensation
+  bool duration_given = false;
   std::string schedule, slave_schedule;
 };
+
+// --scenario runs: the tracking figures (the keys of `lash closed-loop --json`).
+void print_scenario(const hil::ScenarioFigures& f) {
+  auto line = [](const char* what, const hil::Tracking& t) {
+    fmt::print("tracking {} [{}, {}] s: rms error {:.6g} kPa, max |error| {:.6g} kPa ({} samples)\n", what,
+               format_double(t.t0_s), format_double(t.t1_s), t.rms_error, t.max_abs_error, t.samples);
+  };
+  const auto& c = f.compensation;
+  fmt::print("scenario {} (pilot_valve), compensation {}\n", f.file, to_string(f.mode));
+  line("over the score window", f.window);
+  if (f.before_drift) line("before the drift", *f.before_drift);
+  if (f.after_drift) line("after the drift ", *f.after_drift);
+  fmt::print("inverse at the end: right {:.6g} mA, left {:.6g} mA; {} parameter updates; adaptation: {} ({})\n",
+             c.right, c.left, c.updates, to_string(c.reason), c.estimator_reason);
+}
 
 void print_node(const char* who, const hil::NodeFigures& n) {
   fmt::print("{:<7} TET [us] mean {:7.3f} min {:7.3f} max {:8.3f} std {:7.3f} p99 {:8.3f} | CAN I/O [us] mean {:7.2f} "
@@ -93,6 +111,7 @@ void print_report(const hil::RunReport& r) {
                format_double(r.vs_observed_schedule->max_abs_diff_mA), r.vs_observed_schedule->compared);
   else
     fmt::print("observed schedule: {}\n", r.observed_schedule_note);
+  if (r.scenario) print_scenario(*r.scenario);
   fmt::print("logs in {}/ (master.csv, master.events.csv, master_bus.log, slave.csv, slave.events.csv, *.json, "
              "report.json)\n",
              r.out_dir);
@@ -106,6 +125,10 @@ int run_run(const RunOptions& o) {
   so.loop = loop_options(o.common, so.settings);
   so.slave_cpu = o.slave_cpu;
   so.duration_s = o.duration;
+  if (so.settings.scenario) {  // the scenario's duration unless --duration is given
+    if (!o.duration_given) so.duration_s = so.settings.scenario->duration_s;
+    so.node_args = {"--scenario", o.common.scenario, "--compensation", o.common.compensation};
+  }
   so.reference = o.reference;
   so.out_dir = o.out_dir;
   so.isolate = !o.no_isolate;
@@ -132,7 +155,11 @@ int run_simulate(const SimulateOptions& o) {
   CommonOptions co;
   co.config = o.config;
   co.step_ms = o.step_ms;
+  co.scenario = o.scenario.scenario;
+  co.compensation = o.scenario.compensation;
+  co.compensation_given = o.scenario.compensation_given;
   hil::BenchSettings s = load_settings(co);
+  const double duration = s.scenario && !o.duration_given ? s.scenario->duration_s : o.duration;
   if (o.seed >= 0) s.plant.seed = static_cast<std::uint64_t>(o.seed);
   const hil::BenchLayout L = hil::BenchLayout::from_dbc(s.dbc_file);
   const hil::SlaveConfig sc = hil::slave_config(s, L);
@@ -140,7 +167,7 @@ int run_simulate(const SimulateOptions& o) {
   std::size_t N = 0;
   hil::SimulationResult sim;
   if (o.schedule.empty()) {
-    N = hil::steps_for(o.duration, s.step_s, "--duration");
+    N = hil::steps_for(duration, s.step_s, "--duration");
     sim = hil::simulate_bench(L, mc, sc, N);
   } else {  // the run's own schedule: as many control steps as master.csv holds
     const std::filesystem::path mpath(o.schedule);
@@ -166,6 +193,10 @@ int run_simulate(const SimulateOptions& o) {
   write_columns_csv(o.out, {"control_step", "t_s", "reference_kPa", "measured_kPa", "current_mA", "pressure_kPa"},
                     {&c_m, &c_t, &c_r, &c_y, &c_i, &c_p});
   fmt::print(stderr, "lash hil simulate: {} steps at {} ms -> {}\n", N, format_double(s.step_s * 1e3), o.out);
+  if (s.scenario) {
+    print_scenario(hil::scenario_figures(*s.scenario, s.step_s, sim.master, sim.slave, sim.compensation));
+    return kExitOk;
+  }
   if (const auto sr = hil::step_response(c_r, s.step_s, c_p))
     fmt::print("step {} -> {} kPa at t = {} s: 90% rise {:.4f} s, 10% settling {:.4f} s, overshoot {:.1f} %\n",
                format_double(sr->window.y0), format_double(sr->window.y1), format_double(sr->window.t_step_s),
@@ -179,7 +210,9 @@ void add_hil_run(CLI::App* hil, std::function<int()>& run_selected) {
   auto ro = std::make_shared<RunOptions>();
   auto* run = hil->add_subcommand("run", "Slave and master as two processes on a private UDP bus; report");
   add_common(run, ro->common);
-  add_duration(run, ro->duration, "Control time");
+  add_duration(run, ro->duration, "Control time (with --scenario: the scenario's duration_s)")
+      ->each([ro](const std::string&) { ro->duration_given = true; });
+  add_scenario(run, ro->common);
   run->add_option("--reference", ro->reference, "Reference (see `lash hil master --help`)");
   run->add_option("--out-dir", ro->out_dir, "Where the logs go (the files of a run are replaced, never mixed)");
   run->add_option("--seed", ro->seed, "Noise seed of the plant (-1 = from the settings)")
@@ -198,7 +231,9 @@ void add_hil_run(CLI::App* hil, std::function<int()>& run_selected) {
                   "Fixed step [ms], " + format_double(hil::kMinStepMs) + ".." + format_double(hil::kMaxStepMs) +
                       " (0 = from the settings)")
       ->check(CLI::Range(0.0, hil::kMaxStepMs));
-  add_duration(sim, sio->duration, "Control time");
+  add_duration(sim, sio->duration, "Control time (with --scenario: the scenario's duration_s)")
+      ->each([sio](const std::string&) { sio->duration_given = true; });
+  add_scenario(sim, sio->scenario);
   sim->add_option("--reference", sio->reference, "Reference (see `lash hil master --help`)");
   sim->add_option("--seed", sio->seed, "Noise seed of the plant (-1 = from the settings)")
       ->check(CLI::Range(std::int64_t{-1}, INT64_MAX));

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "lash/hil/node_run.hpp"
+#include "lash/hil/simulate.hpp"
 #include "lash/identify/config_file.hpp"
 #include "lash/io/error.hpp"
 #include "lash/io/toml_util.hpp"
@@ -260,16 +262,6 @@ namespace {
 
 double clamp(double x, double lo, double hi) noexcept { return x < lo ? lo : (x > hi ? hi : x); }
 
-struct Score {
-  double t0, t1, sum2 = 0.0, max_abs = 0.0;
-  std::size_t n = 0;
-  void add(double t, double e) noexcept {
-    if (t < t0 - 1e-12 || t > t1 + 1e-12) return;
-    sum2 += e * e;
-    max_abs = std::max(max_abs, std::fabs(e));
-    ++n;
-  }
-};
 
 void reserve(ClosedLoopScenarioTrace& tr, std::size_t n) {
   for (auto* v : {&tr.t_s, &tr.reference, &tr.output, &tr.command, &tr.param_right, &tr.param_left}) v->reserve(n);
@@ -299,6 +291,40 @@ void finish(ClosedLoopScenarioResult& res, const Comp& comp) {
 
 }  // namespace
 
+void apply_to_bench(const ClosedLoopScenario& s, CompensationMode mode, hil::BenchSettings& b) {
+  if (s.rig != rigs::RigKind::pilot_valve)
+    throw InputError(s.file, 0, "rig",
+                     std::string("the HIL bench is the pilot valve (pressure control); a '") + rigs::to_string(s.rig) +
+                         "' scenario runs in `lash closed-loop --scenario` only");
+  if (s.command_min < -2000.0 || s.command_max > 2000.0)
+    throw InputError(s.file, 0, s.command_min < -2000.0 ? "controller.min" : "controller.max",
+                     "the bench drives each solenoid with 0..2000 mA: [controller] min and max must lie in "
+                     "-2000..2000 [mA]");
+  b.set_step(s.dt_s);
+  hil::BenchScenario h;
+  h.file = s.file;
+  h.mode = mode;
+  h.plant.params = s.rig_config.pilot_valve;
+  h.plant.seed = s.seed;
+  for (const Drift& d : s.drift)
+    h.plant.drift.push_back({static_cast<std::uint32_t>(step_of(d.at_s, s.dt_s)), d.after.pilot_valve});
+  h.law.pid = s.pid;
+  h.law.pid.dt_s = s.dt_s;
+  h.law.feedforward = s.feedforward;
+  h.law.command_min = s.command_min;
+  h.law.command_max = s.command_max;
+  h.law.compensation.mode = mode;
+  h.law.compensation.nominal = s.deadzone;
+  h.law.compensation.estimator = s.estimator;
+  h.law.compensation.adaptation = s.adaptation;
+  h.reference = s.reference;
+  h.duration_s = s.duration_s;
+  h.score_t0_s = s.score_t0_s;
+  h.score_t1_s = s.score_t1_s;
+  h.first_drift_s = s.drift.empty() ? -1.0 : static_cast<double>(step_of(s.drift.front().at_s, s.dt_s)) * s.dt_s;
+  b.scenario = std::move(h);
+}
+
 ClosedLoopScenarioResult run_closed_loop_scenario(const ClosedLoopScenario& s, CompensationMode mode) {
   ClosedLoopScenarioResult res;
   res.mode = mode;
@@ -307,35 +333,33 @@ ClosedLoopScenarioResult run_closed_loop_scenario(const ClosedLoopScenario& s, C
   reserve(res.trace, n);
   Signal ref(s.reference, dt);
   Pid pid(s.pid);
-  Score score{s.score_t0_s, s.score_t1_s};
   std::size_t next_drift = 0;
   auto drift_due = [&](std::size_t k) {
     return next_drift < s.drift.size() && static_cast<std::int64_t>(k) >= step_of(s.drift[next_drift].at_s, dt);
   };
   if (s.rig == rigs::RigKind::pilot_valve) {
-    DeadzoneCompensationConfig cc;
-    cc.mode = mode;
-    cc.nominal = s.deadzone;
-    cc.estimator = s.estimator;
-    cc.adaptation = s.adaptation;
-    DeadzoneCompensator comp(cc);
-    rigs::PilotValveRig rig(s.rig_config.pilot_valve, dt, s.seed);
-    double y = rig.initial_output();
-    double p_true = rig.true_pressure_kPa();
-    for (std::size_t k = 0; k < n; ++k) {
-      const double t = static_cast<double>(k) * dt;
-      while (drift_due(k)) rig.set_params(s.drift[next_drift++].after.pilot_valve);
-      const double r = ref.next();
-      const double u = pid.step(r - y) + s.feedforward * r;
-      const double i = clamp(comp.command(u), s.command_min, s.command_max);
-      comp.observe(i, y);
-      const PerSide<double> used = comp.in_use();
-      record(res.trace, t, r, p_true, i, used.right, used.left);
-      score.add(t, r - p_true);
-      y = rig.step(i);
-      p_true = rig.true_pressure_kPa();
+    // One engine: the bench's nodes over the in-process link (what `lash hil run` runs).
+    hil::BenchSettings b;
+    apply_to_bench(s, mode, b);
+    const hil::BenchLayout L;  // the layout of config/hydraulic_bench.dbc
+    const hil::SimulationResult sim =
+        hil::simulate_bench(L, hil::master_config(b, ""), hil::slave_config(b, L), n);
+    for (std::size_t m = 0; m < n && m + 1 < sim.master.size() && m < sim.slave.size(); ++m) {
+      const auto& ml = sim.master[m + 1];  // master row 0 is the CONNECT step
+      record(res.trace, static_cast<double>(m) * dt, ml.reference_kPa, sim.slave[m].pressure_kPa, ml.current_mA,
+             ml.inverse_right_mA, ml.inverse_left_mA);
     }
-    finish(res, comp);
+    res.bench = hil::scenario_figures(*b.scenario, dt, sim.master, sim.slave, sim.compensation);
+    const hil::CompensationState& c = sim.compensation;
+    res.rms_error = res.bench->window.rms_error;
+    res.max_abs_error = res.bench->window.max_abs_error;
+    res.final_right = c.right;
+    res.final_left = c.left;
+    res.updates = c.updates;
+    res.reason = c.reason;
+    res.estimator_identified = c.estimator_identified;
+    res.estimator_reason = c.estimator_reason;
+    return res;
   } else {
     BacklashCompensationConfig cc;
     cc.mode = mode;
@@ -364,15 +388,15 @@ ClosedLoopScenarioResult run_closed_loop_scenario(const ClosedLoopScenario& s, C
       const PerSide<double> used = comp.in_use();
       record(res.trace, t, r, y, v, used.right, used.left);
       res.trace.drive.push_back(w);
-      score.add(t, r - y);
       rig.step(v);
       y = rig.free_position_m();
       w = rig.motor_position_m();
     }
     finish(res, comp);
   }
-  res.rms_error = score.n ? std::sqrt(score.sum2 / static_cast<double>(score.n)) : std::nan("");
-  res.max_abs_error = score.max_abs;
+  const hil::Tracking w = hil::tracking(res.trace.reference, res.trace.output, dt, s.score_t0_s, s.score_t1_s);
+  res.rms_error = w.rms_error;
+  res.max_abs_error = w.max_abs_error;
   return res;
 }
 

@@ -93,8 +93,18 @@ std::unique_ptr<can::Bus> open_node_bus(const std::string& address, const BenchL
 SlaveConfig slave_config(const BenchSettings& s, const BenchLayout& layout, std::size_t log_capacity) {
   SlaveConfig sc;
   sc.plant = s.plant;
-  sc.dto_reply = load_dto_reply(s.dto_log, layout);
+  if (s.dto_log.empty()) {  // settings built in code (lash closed-loop --scenario): a positive CONNECT reply
+    can::Frame dto;
+    dto.id = layout.dto_id;
+    dto.len = 8;
+    dto.data[0] = can::ccp::kCommandReturn;
+    dto.data[1] = can::ccp::kAcknowledge;
+    sc.dto_reply = {dto};
+  } else {
+    sc.dto_reply = load_dto_reply(s.dto_log, layout);
+  }
   sc.log_capacity = log_capacity;
+  if (s.scenario) sc.rig = s.scenario->plant;
   return sc;
 }
 
@@ -102,7 +112,8 @@ MasterConfig master_config(const BenchSettings& s, const std::string& reference,
                            std::size_t log_capacity) {
   MasterConfig mc;
   mc.controller = s.controller;
-  mc.reference = parse_reference(reference);
+  mc.reference = s.scenario ? s.scenario->reference : parse_reference(reference);
+  if (s.scenario) mc.law = s.scenario->law;
   mc.dto_timeout_s = dto_timeout_s > 0 ? dto_timeout_s : s.dto_timeout_s;
   mc.fault_missed_periods = s.fault_missed_periods;
   mc.cro_retry_steps = s.cro_retry_steps;
@@ -230,6 +241,7 @@ MasterRun run_master_node(const BenchSettings& s, const MasterRunOptions& o, con
   out.stats.state = master.state();
   out.stats.control_steps = master.control_steps();
   out.stats.handshake_s = master.handshake_s();
+  out.stats.compensation = master.compensation();
   return out;
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -74,6 +75,11 @@ SlaveNode::SlaveNode(const BenchLayout& layout, SlaveConfig config)
   ramp_step_mA_ = cfg_.e2e.ramp_mA_per_s * cfg_.plant.dt_s;
   current_mA_ = command_mA_ = cfg_.current_min_mA;
   plant_.reset(0.0);
+  if (cfg_.rig) {
+    cfg_.rig->params.validate();
+    for (const auto& c : cfg_.rig->drift) c.params.validate();
+    rig_.emplace(cfg_.rig->params, cfg_.plant.dt_s, cfg_.rig->seed);
+  }
   log_.resize(cfg_.log_capacity);
 }
 
@@ -128,7 +134,8 @@ void SlaveNode::step(can::Bus& bus, double now_s) noexcept {
         ++dropped;
         continue;
       }
-      command_mA_ = c.solenoid_a_mA;  // B current and restrictor command are not modelled
+      // B current (scenario rig only: A − B) and restrictor command are not modelled by the B1 plant
+      command_mA_ = rig_ ? c.solenoid_a_mA - c.solenoid_b_mA : c.solenoid_a_mA;
       fresh = true;
     } else if (layout_.is_connect(*f)) {
       reply_dto(bus);
@@ -183,15 +190,31 @@ void SlaveNode::step(can::Bus& bus, double now_s) noexcept {
 
   // 3. The current driver: never outside its range, whatever was decided above.
   double i = current_mA_;
-  if (!(i >= cfg_.current_min_mA)) i = cfg_.current_min_mA;  // also NaN
+  const double lo = rig_ ? -cfg_.current_max_mA : cfg_.current_min_mA;  // the scenario rig: both solenoids
+  if (!(i >= lo)) i = lo;  // also NaN
   if (i > cfg_.current_max_mA) i = cfg_.current_max_mA;
   current_mA_ = i;
 
-  // 4. Plant and sensor frame.
-  plant_.apply(i);
-  const double y = plant_.measure();
+  // 4. Plant and sensor frame. A scenario's rig: step s applies the command of control step
+  // s − 1, so a drift at control step m reaches the rig from slave step m + 1 on.
+  double y = 0.0, p_true = 0.0;
+  std::uint16_t raw = 0;
+  if (rig_) {
+    const auto& drift = cfg_.rig->drift;
+    while (next_drift_ < drift.size() && step_ >= drift[next_drift_].control_step + 1)
+      rig_->set_params(drift[next_drift_++].params);
+    // The rig's bias-corrected pressure difference, offset into the sensor code's range.
+    raw = encode_pressure_raw(rig_->step(i) + kScenarioPressureZero_kPa);
+    y = decode_pressure_raw(raw) - kScenarioPressureZero_kPa;
+    p_true = rig_->true_pressure_kPa();
+  } else {
+    plant_.apply(i);
+    y = plant_.measure();
+    raw = plant_.last_raw();
+    p_true = plant_.true_pressure_kPa();
+  }
   SensorMsg s;
-  s.pilot_raw = plant_.last_raw();
+  s.pilot_raw = raw;
   s.supply_raw = 0;  // supply pressure is not modelled: sent as 0 (thesis Fig 2.17)
   s.counter = static_cast<std::uint16_t>(step_);
   if (bus.send(layout_.pack_sensors(s)))
@@ -200,7 +223,7 @@ void SlaveNode::step(can::Bus& bus, double now_s) noexcept {
     ++send_fail_;
   if (n_log_ < log_.size())
     log_[n_log_++] =
-        SlaveStepLog{step_, state_, cmd_.extended, fresh, dropped, i, plant_.true_pressure_kPa(), y, s.pilot_raw};
+        SlaveStepLog{step_, state_, cmd_.extended, fresh, dropped, i, p_true, y, s.pilot_raw};
   ++step_;
 }
 
@@ -215,6 +238,15 @@ MasterNode::MasterNode(const BenchLayout& layout, MasterConfig config)
   if (cfg_.cro_retry_steps == 0) throw std::invalid_argument("master: cro_retry_steps must be >= 1");
   if (!(cfg_.dto_timeout_s > 0)) throw std::invalid_argument("master: dto_timeout_s must be > 0");
   validate(cfg_.e2e, layout_.sensor_counter_bits(), "master");
+  if (cfg_.law) {
+    const CompensatedLaw& c = *cfg_.law;
+    if (std::fabs(c.pid.dt_s - cfg_.controller.pid.dt_s) > 1e-12 * cfg_.controller.pid.dt_s)
+      throw std::invalid_argument("master: the scenario law's dt differs from the step");
+    if (!(c.command_min <= c.command_max) || !std::isfinite(c.feedforward))
+      throw std::invalid_argument("master: the scenario law needs command_min <= command_max and a finite feedforward");
+    pid_.emplace(c.pid);
+    comp_.emplace(c.compensation);
+  }
   sens_ = make_tracker(layout_.sensor_counter_bits(), cfg_.e2e);
   ramp_step_mA_ = cfg_.e2e.ramp_mA_per_s * cfg_.controller.pid.dt_s;
   log_.resize(cfg_.log_capacity);
@@ -268,7 +300,7 @@ bool MasterNode::step(can::Bus& bus, double now_s) noexcept {
         ++dropped;
         continue;
       }
-      measured_kPa_ = decode_pressure_raw(s.pilot_raw);
+      measured_kPa_ = decode_pressure_raw(s.pilot_raw) - (comp_ ? kScenarioPressureZero_kPa : 0.0);
       sensor_counter_ = s.counter;
       fresh_ = true;
     } else if (layout_.is_connect_ack(*f)) {
@@ -285,7 +317,7 @@ bool MasterNode::step(can::Bus& bus, double now_s) noexcept {
   if (state_ == MasterState::startup) {
     if (dto && cro_sent_) {
       handshake_s_ = now_s - first_cro_s_;
-      controller_.reset();
+      reset_law();
       go(MasterState::connected, NodeEventKind::connected, now_s);
     } else if (cro_sent_ && now_s - first_cro_s_ >= cfg_.dto_timeout_s) {
       go(MasterState::failed, NodeEventKind::dto_timeout, now_s);
@@ -310,7 +342,8 @@ bool MasterNode::step(can::Bus& bus, double now_s) noexcept {
   }
   if (send_cmd) {
     CommandMsg c;
-    c.solenoid_a_mA = current_mA_;
+    c.solenoid_a_mA = current_mA_ > 0.0 ? current_mA_ : 0.0;
+    if (comp_ && current_mA_ < 0.0) c.solenoid_b_mA = -current_mA_;  // scenario law: both solenoids
     c.counter = cmd_counter_;
     send(bus, layout_.pack_command(c), now_s);
     ++cmd_counter_;
@@ -327,12 +360,51 @@ bool MasterNode::step(can::Bus& bus, double now_s) noexcept {
     l.sensor_seq = fresh_ ? static_cast<std::int64_t>(sens_.extended) : -1;
     l.dropped = dropped;
     l.current_mA = send_cmd ? current_mA_ : 0.0;
-    l.integrator_mA = controller_.pid().integrator();
+    l.integrator_mA = pid_ ? pid_->integrator() : controller_.pid().integrator();
+    if (comp_ && cfg_.law->compensation.mode != CompensationMode::none) {
+      l.inverse_right_mA = comp_->inverse().params().offset_right;
+      l.inverse_left_mA = -comp_->inverse().params().offset_left;
+    }
     l.command_counter = static_cast<std::uint16_t>(cmd_counter_ - (send_cmd ? 1 : 0));
     l.command_sent = send_cmd;
   }
   ++k_;
   return state_ != MasterState::failed;
+}
+
+// The control law of one sample: the bench's controller (PID → fixed offset → saturation) or a
+// scenario's compensated law (nodes.hpp, CompensatedLaw).
+double MasterNode::law(double r, double y) noexcept {
+  if (!comp_) return controller_.step(r, y);
+  const CompensatedLaw& c = *cfg_.law;
+  const double u = pid_->step(r - y) + c.feedforward * r;
+  double i = comp_->command(u);
+  i = i < c.command_min ? c.command_min : (i > c.command_max ? c.command_max : i);
+  comp_->observe(i, y);
+  return i;
+}
+
+void MasterNode::reset_law() noexcept {
+  controller_.reset();
+  if (pid_) pid_->reset();
+}
+
+CompensationState MasterNode::compensation() const noexcept {
+  CompensationState c;
+  if (!comp_) return c;
+  c.on = true;
+  c.mode = cfg_.law->compensation.mode;
+  if (c.mode != CompensationMode::none) {
+    c.right = comp_->inverse().params().offset_right;
+    c.left = -comp_->inverse().params().offset_left;
+  }
+  c.updates = comp_->updates();
+  c.reason = comp_->reason();
+  c.estimator_identified = comp_->estimator().params(Side::right).identified &&
+                           comp_->estimator().params(Side::left).identified;
+  std::snprintf(c.estimator_reason, sizeof c.estimator_reason, "right: %s; left: %s",
+                comp_->estimator_reason(Side::right), comp_->estimator_reason(Side::left));
+  return c;
 }
 
 // One control step in states connected..safe: sets current_mA_.
@@ -349,7 +421,7 @@ void MasterNode::control(can::Bus& bus, double r, double now_s) noexcept {
     case MasterState::connected:
       if (fresh_ && !bad_) {
         go(MasterState::running, NodeEventKind::input_valid, now_s);
-        current_mA_ = controller_.step(r, measured_kPa_);
+        current_mA_ = law(r, measured_kPa_);
       } else if (stale) {
         to_safe(NodeEventKind::sensor_timeout);
       } else {
@@ -360,7 +432,7 @@ void MasterNode::control(can::Bus& bus, double r, double now_s) noexcept {
       if (bad_) {
         go(MasterState::degraded, NodeEventKind::input_implausible, now_s);
       } else if (fresh_) {
-        current_mA_ = controller_.step(r, measured_kPa_);
+        current_mA_ = law(r, measured_kPa_);
       } else if (stale) {
         // No forget(): frames missed now are counted lost when the counter resumes; a restarted
         // slave (counter back at 0) re-synchronises after sync_frames frames.
@@ -372,15 +444,15 @@ void MasterNode::control(can::Bus& bus, double r, double now_s) noexcept {
         to_safe(NodeEventKind::sensor_timeout);
       } else if (recovered) {  // the PID resumes where it was frozen
         go(MasterState::running, NodeEventKind::input_recovered, now_s);
-        current_mA_ = controller_.step(r, measured_kPa_);
+        current_mA_ = law(r, measured_kPa_);
       }
       break;
     case MasterState::safe:
       current_mA_ = safe_mA;
       if (recovered) {
         go(MasterState::running, NodeEventKind::input_resumed, now_s);
-        controller_.reset();
-        current_mA_ = controller_.step(r, measured_kPa_);
+        reset_law();
+        current_mA_ = law(r, measured_kPa_);
       } else if (stale && k_ - last_cro_k_ >= cfg_.cro_retry_steps) {  // reconnect a restarted slave
         send(bus, layout_.pack_connect(cro_ctr_), now_s);
         last_cro_k_ = k_;

@@ -1,5 +1,6 @@
 #include "lash/hil/report.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -103,6 +104,46 @@ std::size_t off_schedule_steps(const std::vector<MasterStepLog>& master, const s
   return off.size();
 }
 
+Tracking tracking(const std::vector<double>& reference, const std::vector<double>& output, double dt_s, double t0_s,
+                  double t1_s) {
+  Tracking w;
+  w.t0_s = t0_s;
+  w.t1_s = t1_s;
+  double sum2 = 0.0;
+  const std::size_t n = std::min(reference.size(), output.size());
+  for (std::size_t m = 0; m < n; ++m) {
+    const double t = static_cast<double>(m) * dt_s;
+    if (t < t0_s - 1e-12 || t > t1_s + 1e-12) continue;
+    const double e = reference[m] - output[m];
+    sum2 += e * e;
+    w.max_abs_error = std::max(w.max_abs_error, std::fabs(e));
+    ++w.samples;
+  }
+  w.rms_error = w.samples ? std::sqrt(sum2 / static_cast<double>(w.samples)) : std::nan("");
+  return w;
+}
+
+ScenarioFigures scenario_figures(const BenchScenario& s, double dt_s, const std::vector<MasterStepLog>& master,
+                                 const std::vector<SlaveStepLog>& slave, const CompensationState& compensation) {
+  std::vector<double> ref, y;
+  for (const auto& l : master)
+    if (l.control_step >= 0) ref.push_back(l.reference_kPa);
+  for (const auto& l : slave) y.push_back(l.pressure_kPa);
+  ScenarioFigures f;
+  f.file = s.file;
+  f.mode = s.mode;
+  f.window = tracking(ref, y, dt_s, s.score_t0_s, s.score_t1_s);
+  const double end = static_cast<double>(std::min(ref.size(), y.size())) * dt_s;
+  if (s.first_drift_s >= 0) {  // a run that ended before the drift has no "after"
+    // [0, drift): the last sample before the drift's control step.
+    const double before_end = static_cast<double>(std::llround(s.first_drift_s / dt_s) - 1) * dt_s;
+    f.before_drift = tracking(ref, y, dt_s, 0.0, before_end);
+    if (s.first_drift_s < end) f.after_drift = tracking(ref, y, dt_s, s.first_drift_s, end);
+  }
+  f.compensation = compensation;
+  return f;
+}
+
 NodeFigures node_figures(const NodeStats& stats, const LoopTrace& loop) {
   NodeFigures f;
   f.tet_us = rt::tet_us(loop.records);
@@ -118,7 +159,7 @@ NodeFigures node_figures(const NodeStats& stats, const LoopTrace& loop) {
 }
 
 void make_run_report(RunReport& rep, const MasterRun* master, const std::vector<SlaveRun>& slaves,
-                     const std::vector<MasterStepLog>& simulated) {
+                     const std::vector<MasterStepLog>& simulated, const BenchScenario* scenario) {
   rep.have_master = master != nullptr;
   rep.have_slave = !slaves.empty();
   rep.frames = {};
@@ -154,6 +195,8 @@ void make_run_report(RunReport& rep, const MasterRun* master, const std::vector<
       y.push_back(l.measured_kPa);
     }
     rep.step = step_response(ref, rep.step_s, p, &y);
+    if (scenario)
+      rep.scenario = scenario_figures(*scenario, rep.step_s, master->log, slaves[0].log, master->stats.compensation);
   }
 }
 
@@ -178,10 +221,35 @@ json exit_json(const NodeExit& e) {
   return j;
 }
 
+json num(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
+
+json tracking_json(const Tracking& t) {
+  return json{{"rms_error", num(t.rms_error)}, {"max_abs_error", num(t.max_abs_error)}, {"unit", "kPa"},
+              {"window_s", {t.t0_s, t.t1_s}}, {"samples", t.samples}};
+}
+
 json metrics_json(const StepMetrics& m) {
   return json{{"rise_s", m.rise_s}, {"settling_s", m.settling_s}, {"overshoot_pct", m.overshoot_pct}};
 }
 }  // namespace
+
+std::string scenario_json(const ScenarioFigures& f) {
+  const CompensationState& c = f.compensation;
+  json j;
+  j["scenario"] = f.file;
+  j["rig"] = "pilot_valve";
+  j["compensation_mode"] = to_string(f.mode);
+  j["score_window_s"] = {f.window.t0_s, f.window.t1_s};
+  j["tracking"] = tracking_json(f.window);
+  if (f.before_drift) j["tracking_before_drift"] = tracking_json(*f.before_drift);
+  if (f.after_drift) j["tracking_after_drift"] = tracking_json(*f.after_drift);
+  j["compensation"] = {{"final", {{"right", c.right}, {"left", c.left}}}, {"unit", "mA"}};
+  j["adaptation"] = {{"updates", c.updates},
+                     {"reason", to_string(c.reason)},
+                     {"estimator_identified", c.estimator_identified},
+                     {"estimator_reason", std::string(c.estimator_reason)}};
+  return j.dump();
+}
 
 std::string run_report_json(const RunReport& r) {
   json out;
@@ -242,6 +310,10 @@ std::string run_report_json(const RunReport& r) {
       out["max_abs_diff_vs_observed_schedule_kPa"] = nullptr;
       out["observed_schedule_note"] = r.observed_schedule_note;
     }
+  }
+  if (r.scenario) {  // the keys of `lash closed-loop --json` (scenario_json)
+    const json sj = json::parse(scenario_json(*r.scenario));
+    for (auto& [k, v] : sj.items()) out[k] = v;
   }
   out["out_dir"] = r.out_dir;
   return out.dump(2) + "\n";

@@ -203,6 +203,7 @@ SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& m
   SimulationResult r;
   r.master.assign(master.log().begin(), master.log().end());
   r.slave.assign(slave.log().begin(), slave.log().end());
+  r.compensation = master.compensation();
   r.events.assign(master.events().begin(), master.events().end());
   return r;
 }

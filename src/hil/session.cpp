@@ -147,6 +147,7 @@ std::vector<std::string> loop_args(const LoopOptions& l, const SessionOptions& o
   if (!l.hold_dma_latency) a.push_back("--no-dma-latency");
   a.insert(a.end(), {"--overrun-policy", l.policy == rt::OverrunPolicy::stop ? "stop" : "tolerate",
                      "--max-overruns", std::to_string(l.max_overruns)});
+  a.insert(a.end(), o.node_args.begin(), o.node_args.end());
   return a;
 }
 
@@ -328,7 +329,8 @@ RunReport Session::run(const std::function<void(const std::string&)>& progress) 
   std::vector<MasterStepLog> simulated;
   if (have_master && mrun.stats.control_steps > 0)
     simulated = simulate_bench(L, mc, sc, static_cast<std::size_t>(mrun.stats.control_steps)).master;
-  make_run_report(rep, have_master ? &mrun : nullptr, sruns, simulated);
+  make_run_report(rep, have_master ? &mrun : nullptr, sruns, simulated,
+                  o_.settings.scenario ? &*o_.settings.scenario : nullptr);
   if (!simulated.empty()) {  // the same closed loop, fed the frames each node logged it used
     if (sruns.size() != 1 || sruns[0].log.empty()) {
       rep.observed_schedule_note = "not replayed: the schedule of one slave from start to end is needed";

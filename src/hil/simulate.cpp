@@ -81,6 +81,7 @@ SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& m
   r.master.assign(master.log().begin(), master.log().end());
   r.slave.assign(slave.log().begin(), slave.log().end());
   r.events.assign(master.events().begin(), master.events().end());
+  r.compensation = master.compensation();
   return r;
 }
 

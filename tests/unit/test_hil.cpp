@@ -1,6 +1,7 @@
 // Unit tests of the HIL nodes: frame layout against hand-packed bytes, sequence-counter
 // bookkeeping, the closed-loop simulation against a hand-written discrete loop, faults.
 #include <gtest/gtest.h>
+#include <algorithm>
 
 #include <cmath>
 #include <numbers>
@@ -227,6 +228,71 @@ TEST(HilSimulate, EqualsHandWrittenDiscreteLoop) {
     if (t > 0.8 && t < 1.0) worst = std::max(worst, std::abs(sim.master[k + 1].measured_kPa - 1300.0));
   }
   EXPECT_LT(worst, 4 * 7.28);
+}
+
+// --scenario nodes against a hand-written loop: the E4 rig with a drift at control step 200, the
+// PID + feedforward + adaptive deadzone compensator, the bus by hand (negative currents on
+// solenoid B, 0.1 mA steps; the pressure difference + 2000 kPa as the sensor code).
+TEST(HilSimulate, ScenarioEqualsHandWrittenLoopWithDriftAndBothSolenoids) {
+  const double T = 0.005;
+  const std::size_t N = 1200;
+  BenchLayout L;
+  RigPlant plant;
+  plant.seed = 7;
+  rigs::PilotValveRigParams drifted = plant.params;
+  drifted.deadzone_right_mA = 380.0;
+  plant.drift.push_back({200, drifted});
+  CompensatedLaw law;
+  law.pid.dt_s = T;
+  law.pid.gains.kp = 0.5;
+  law.pid.gains.ki_per_s = 10.0;
+  law.pid.anti_windup = AntiWindup::clamp;
+  law.pid.output_min = -2000.0;
+  law.pid.output_max = 2000.0;
+  law.feedforward = 0.465;
+  law.compensation.mode = CompensationMode::adaptive;
+  law.compensation.nominal = DeadzoneInverseParams::from_deadzone(288.0, 1.0);
+  law.compensation.estimator.model = ModelKind::input_deadzone;
+  law.compensation.estimator.dt_s = T;
+  law.compensation.estimator.guess_right = 432.0;
+  law.compensation.estimator.guess_left = -444.0;
+  MasterConfig mc = master_config(T);
+  mc.reference = SignalSpec{};
+  mc.reference.kind = Waveform::sine;
+  mc.reference.amplitude = 600.0;
+  mc.reference.frequency_rad_s = 2.0 * 3.141592653589793;
+  mc.law = law;
+  SlaveConfig sc = slave_config(T);
+  sc.rig = plant;
+  const SimulationResult sim = simulate_bench(L, mc, sc, N);
+  ASSERT_EQ(sim.master.size(), N + 1);
+
+  rigs::PilotValveRig rig(plant.params, T, plant.seed);
+  Pid pid(law.pid);
+  DeadzoneCompensator comp(law.compensation);
+  Signal ref(mc.reference, T);
+  double applied = 0.0;  // slave step 0 runs before any command
+  bool negative = false;
+  for (std::size_t k = 0; k < N; ++k) {
+    if (k == 201) rig.set_params(drifted);  // slave step 201 applies control step 200's command
+    const std::uint16_t raw = encode_pressure_raw(rig.step(applied) + 2000.0);
+    const double y = decode_pressure_raw(raw) - 2000.0;
+    const double r = ref.next();
+    double i = comp.command(pid.step(r - y) + law.feedforward * r);
+    i = std::clamp(i, law.command_min, law.command_max);
+    comp.observe(i, y);
+    negative = negative || i < -300.0;
+    applied = i >= 0 ? L.quantize_current(i) : -L.quantize_current(-i);
+    const MasterStepLog& m = sim.master[k + 1];
+    ASSERT_EQ(m.state, MasterState::running) << k;
+    ASSERT_EQ(m.measured_kPa, y) << k;
+    ASSERT_EQ(m.current_mA, i) << k;
+    ASSERT_EQ(sim.slave[k].pressure_kPa, rig.true_pressure_kPa()) << k;
+    ASSERT_EQ(m.inverse_right_mA, comp.inverse().params().offset_right) << k;
+  }
+  EXPECT_TRUE(negative);  // solenoid B was used
+  EXPECT_EQ(sim.compensation.updates, comp.updates());
+  EXPECT_TRUE(sim.compensation.on);
 }
 
 TEST(HilMaster, SafeStateAfterThreeMissedPeriodsAndResume) {

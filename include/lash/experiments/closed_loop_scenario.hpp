@@ -16,11 +16,14 @@
 /// The run loop calls only noexcept, allocation-free step functions per sample.
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "lash/control/adaptive_compensator.hpp"
 #include "lash/control/pid.hpp"
+#include "lash/hil/report.hpp"
+#include "lash/hil/settings.hpp"
 #include "lash/rigs/rig.hpp"
 #include "lash/signals/signal.hpp"
 
@@ -77,9 +80,19 @@ struct ClosedLoopScenarioResult {
   std::string estimator_reason;  ///< the estimator's side of the verdict
   bool estimator_identified = false;
   ClosedLoopScenarioTrace trace;
+  /// pilot_valve: the bench's figures (tracking over the window and before/after the first drift).
+  std::optional<hil::ScenarioFigures> bench;
 };
 
-/// Runs the scenario with the given compensation. Throws std::invalid_argument on an invalid
+/// The bench settings `b` with this scenario (`lash hil run|simulate --scenario`): the slave's
+/// rig and drifts, the master's law, reference and step. The bench is the pilot valve (each
+/// solenoid 0..2000 mA, hil/nodes.hpp kScenarioPressureZero_kPa): a coupled_carts scenario, a
+/// [controller] min below −2000 or max above 2000 mA is refused (InputError naming file and key).
+void apply_to_bench(const ClosedLoopScenario& s, CompensationMode mode, hil::BenchSettings& b);
+
+/// Runs the scenario with the given compensation. A pilot_valve scenario runs on the bench's
+/// nodes (hil::simulate_bench with apply_to_bench's settings): the same step code, timing and
+/// bus quantisation as `lash hil run --scenario`, so the figures agree bit for bit. Throws std::invalid_argument on an invalid
 /// configuration (a scenario from load_closed_loop_scenario is valid).
 ClosedLoopScenarioResult run_closed_loop_scenario(const ClosedLoopScenario& s, CompensationMode mode);
 

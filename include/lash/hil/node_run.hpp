@@ -84,6 +84,7 @@ struct NodeStats {
   // master only
   std::int64_t control_steps = 0;
   double handshake_s = -1.0;
+  CompensationState compensation;  ///< the scenario law's compensator at the end (on = false without one)
   // slave only
   bool connected = false;
   std::uint64_t dto_replies = 0;

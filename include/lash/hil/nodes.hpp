@@ -33,14 +33,17 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
 #include "lash/can/bus.hpp"
+#include "lash/control/adaptive_compensator.hpp"
 #include "lash/control/controller.hpp"
 #include "lash/hil/bench_layout.hpp"
 #include "lash/hil/e2e.hpp"
 #include "lash/rigs/pilot_valve_model.hpp"
+#include "lash/rigs/pilot_valve_rig.hpp"
 #include "lash/signals/signal.hpp"
 
 namespace lash::hil {
@@ -125,6 +128,52 @@ class EventLog {
   std::uint64_t dropped_ = 0;
 };
 
+// ----------------------------------------------------------------------------- scenario
+// `lash hil run|simulate --scenario FILE --compensation MODE` (docs/compensation.md): the slave
+// emulates the E4 valve rig with the scenario's drifts, the master runs the scenario's
+// compensated law. `lash closed-loop --scenario` on a valve scenario runs these very nodes
+// (hil::simulate_bench), so its figures and the emulation's agree bit for bit.
+
+/// Under a scenario the valve is driven both ways and its output is a pressure difference
+/// (rigs/pilot_valve_rig.hpp): the master sends a positive current as SolenoidA_Current and a
+/// negative one as SolenoidB_Current (the slave applies A − B), and the slave's sensor sends the
+/// rig's bias-corrected pressure difference plus this zero offset as PilotPressure_Duty (the
+/// DBC's 5..95 % carries −48..4346 kPa: the difference fits as −2048..2346 kPa).
+inline constexpr double kScenarioPressureZero_kPa = 2000.0;
+
+/// The slave's plant under a scenario: the E4 valve rig (rigs/pilot_valve_rig.hpp) and its drifts.
+struct RigPlant {
+  rigs::PilotValveRigParams params;   ///< the rig at t = 0
+  std::uint64_t seed = 1;             ///< the rig's noise seed
+  struct Change {
+    std::uint32_t control_step = 0;   ///< first master control step m whose command meets the new rig
+    rigs::PilotValveRigParams params; ///< the rig from then on (valid)
+  };
+  std::vector<Change> drift;          ///< in time order
+};
+
+/// The master's law under a scenario:
+///   u(m) = PID(r − y)(m) + feedforward·r(m);  i(m) = clamp(DI(u(m)), command_min, command_max)
+/// with DI the deadzone compensator (none/fixed/adaptive, control/adaptive_compensator.hpp),
+/// whose estimator then observes (i(m), y(m)).
+struct CompensatedLaw {
+  PidConfig pid;                      ///< dt_s = the step
+  double feedforward = 0.0;           ///< [mA/kPa]
+  double command_min = -2000.0, command_max = 2000.0;  ///< [mA], inside ±the bench's current range
+  DeadzoneCompensationConfig compensation;
+};
+
+/// The compensator's state at the end of a run (trivially copyable: it crosses the hand-over).
+struct CompensationState {
+  bool on = false;                    ///< a scenario law ran
+  CompensationMode mode = CompensationMode::none;
+  double right = 0.0, left = 0.0;     ///< the inverse's edges in use (left as a negative current; 0 for none) [mA]
+  std::uint64_t updates = 0;          ///< samples on which the inverse's parameters changed
+  AdaptationReason reason = AdaptationReason::nominal;
+  bool estimator_identified = false;  ///< both sides identified by the estimator's verdict
+  char estimator_reason[320] = {};    ///< "right: …; left: …" (truncated to fit)
+};
+
 // ----------------------------------------------------------------------------- slave
 
 struct SlaveConfig {
@@ -135,6 +184,7 @@ struct SlaveConfig {
   std::uint32_t stale_periods = 3;        ///< steps without a plausible command → degraded
   double current_min_mA = 0.0;            ///< the current driver's range: the output is clamped to it [mA]
   double current_max_mA = 2000.0;
+  std::optional<RigPlant> rig;            ///< a scenario's rig instead of `plant` (scenario section above)
 };
 
 /// One slave step.
@@ -186,6 +236,8 @@ class SlaveNode {
   double ramp_step_mA_ = 0.0;
   std::uint32_t step_ = 0;
   std::uint64_t sent_ = 0, send_fail_ = 0, dto_replies_ = 0, ignored_ = 0;
+  std::optional<rigs::PilotValveRig> rig_;
+  std::size_t next_drift_ = 0;
   std::vector<SlaveStepLog> log_;
   std::size_t n_log_ = 0;
 };
@@ -201,6 +253,7 @@ struct MasterConfig {
   std::size_t log_capacity = 0;            ///< steps logged (preallocated)
   std::size_t bus_log_capacity = 0;        ///< frames logged (preallocated); 0 → 4·log_capacity + 64
   E2EConfig e2e;                           ///< plausibility, recovery and ramp settings
+  std::optional<CompensatedLaw> law;       ///< a scenario's law instead of `controller`'s PID + fixed offset
 };
 
 struct MasterStepLog {
@@ -218,6 +271,8 @@ struct MasterStepLog {
   double integrator_mA = 0.0;              ///< the PID's integrator state after the step [mA]
   std::uint16_t command_counter = 0;
   bool command_sent = false;
+  double inverse_right_mA = 0.0;           ///< scenario law: the deadzone inverse's edges after the step [mA]
+  double inverse_left_mA = 0.0;            ///< (left as a negative current; 0 without a scenario or for none)
 };
 
 class MasterNode {
@@ -241,15 +296,21 @@ class MasterNode {
   std::uint64_t send_failures() const noexcept { return send_fail_; }
   std::uint64_t ignored_frames() const noexcept { return ignored_; }
   double handshake_s() const noexcept { return handshake_s_; }  ///< first CRO → DTO [s]; −1 before
+  /// The scenario law's compensator at this point (on = false without a scenario).
+  CompensationState compensation() const noexcept;
 
  private:
   void go(MasterState to, NodeEventKind why, double now_s) noexcept;
   void send(can::Bus& bus, const can::Frame& f, double now_s) noexcept;
   void record(const can::Frame& f, bool sent) noexcept;
   void control(can::Bus& bus, double r, double now_s) noexcept;
+  double law(double r, double y) noexcept;
+  void reset_law() noexcept;
   BenchLayout layout_;
   MasterConfig cfg_;
   ClosedLoopDiscrete controller_;
+  std::optional<Pid> pid_;                     ///< scenario law
+  std::optional<DeadzoneCompensator> comp_;    ///< scenario law
   Signal reference_;
   MasterState state_ = MasterState::startup;
   SeqTracker sens_;

@@ -12,6 +12,7 @@
 #include "lash/metrics/step_response.hpp"
 #include "lash/hil/node_run.hpp"
 #include "lash/hil/nodes.hpp"
+#include "lash/hil/settings.hpp"
 #include "lash/rt/periodic.hpp"
 
 namespace lash::hil {
@@ -61,6 +62,30 @@ std::optional<StepResponse> step_response(const std::vector<double>& reference_k
 /// Late frames, lost frames or a node running late show up here.
 std::size_t off_schedule_steps(const std::vector<MasterStepLog>& master, const std::vector<SlaveStepLog>& slave,
                                std::int64_t control_steps);
+
+/// Tracking figures of a scenario run over a time window (`tracking.*` of report.json and of
+/// `lash closed-loop --json`): sample m at t = m·dt_s counts when t0_s ≤ t ≤ t1_s.
+struct Tracking {
+  double t0_s = 0.0, t1_s = 0.0;
+  std::size_t samples = 0;
+  double rms_error = 0.0;      ///< RMS of r − y over the window [output unit]; NaN without samples
+  double max_abs_error = 0.0;  ///< max |r − y| over the window [output unit]
+};
+Tracking tracking(const std::vector<double>& reference, const std::vector<double>& output, double dt_s, double t0_s,
+                  double t1_s);
+
+/// A scenario run on the bench, from the nodes' logs: control step m pairs the master's r(m)
+/// with the plant pressure of slave step m (noise-free, the y(m) the master used).
+struct ScenarioFigures {
+  std::string file;
+  CompensationMode mode = CompensationMode::none;
+  Tracking window;                         ///< the scenario's score_window_s
+  std::optional<Tracking> before_drift;    ///< [0, first drift)
+  std::optional<Tracking> after_drift;     ///< [first drift, end]
+  CompensationState compensation;          ///< the master's compensator at the end
+};
+ScenarioFigures scenario_figures(const BenchScenario& s, double dt_s, const std::vector<MasterStepLog>& master,
+                                 const std::vector<SlaveStepLog>& slave, const CompensationState& compensation);
 
 /// Loop figures of one node [µs] and its counters.
 struct NodeFigures {
@@ -113,12 +138,17 @@ struct RunReport {
   std::optional<SimulationDiff> vs_observed_schedule;
   std::string observed_schedule_note;
   std::size_t off_schedule = 0;
+  std::optional<ScenarioFigures> scenario;  ///< --scenario runs
 };
 
 /// Fills the computed part of `report` from the master's run, the slaves' runs (first = the one
 /// started with the master) and the simulation of the same control steps (simulate_bench).
 void make_run_report(RunReport& report, const MasterRun* master, const std::vector<SlaveRun>& slaves,
-                     const std::vector<MasterStepLog>& simulated);
+                     const std::vector<MasterStepLog>& simulated, const BenchScenario* scenario = nullptr);
+/// The scenario part of report.json and of `lash closed-loop --json` on a valve scenario:
+/// scenario, rig, compensation_mode, score_window_s, tracking{,_before_drift,_after_drift},
+/// compensation.final, adaptation; one JSON object's text.
+std::string scenario_json(const ScenarioFigures& f);
 /// report.json text (fields documented in docs/hil.md).
 std::string run_report_json(const RunReport& report);
 

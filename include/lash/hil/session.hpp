@@ -38,6 +38,9 @@ struct SessionOptions {
   bool isolate = true;                   ///< private network namespace (else the host's network)
   bool restart_slave = false;            ///< watchdog: start a dead slave again
   std::string executable = "/proc/self/exe";  ///< the lash binary the nodes run
+  /// Passed on to both nodes (`--scenario FILE --compensation MODE`: the nodes load the
+  /// scenario themselves; `settings.scenario` must hold the same for the report).
+  std::vector<std::string> node_args;
   /// Checks what can be checked before any process starts (reference, duration, loop options,
   /// output directory writable); throws InputError naming the option.
   void validate() const;

@@ -4,16 +4,32 @@
 /// bus address, step, plant (SPEC B1) and controller (SPEC B2) parameters, master
 /// fault handling; and the `KIND:key=value,…` reference syntax. Not real-time safe.
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "lash/can/frame.hpp"
 #include "lash/control/controller.hpp"
 #include "lash/hil/bench_layout.hpp"
+#include "lash/hil/nodes.hpp"
 #include "lash/rigs/pilot_valve_model.hpp"
 #include "lash/signals/signal.hpp"
 
 namespace lash::hil {
+
+/// A closed-loop scenario on the bench (`--scenario FILE --compensation MODE`, docs/compensation.md):
+/// the slave's rig and drifts, the master's law and reference, and what the report scores.
+/// Built from a scenario file by experiments::apply_to_bench.
+struct BenchScenario {
+  std::string file;
+  CompensationMode mode = CompensationMode::adaptive;
+  RigPlant plant;
+  CompensatedLaw law;
+  SignalSpec reference;                    ///< r(m) [kPa] (replaces --reference)
+  double duration_s = 0.0;                 ///< the scenario's duration [s]
+  double score_t0_s = 0.0, score_t1_s = 0.0;  ///< score window [s]
+  double first_drift_s = -1.0;             ///< time of the first drift [s]; −1 = none
+};
 
 struct BenchSettings {
   std::filesystem::path dbc_file;          ///< relative paths in the file are relative to the file
@@ -26,6 +42,7 @@ struct BenchSettings {
   std::uint32_t fault_missed_periods = 3;
   std::uint32_t cro_retry_steps = 10;
   std::vector<std::string> warnings;       ///< deprecated keys read (the CLI prints them)
+  std::optional<BenchScenario> scenario;   ///< set by --scenario: the nodes run it instead of plant/controller
   /// Sets step_s in plant and controller (after a --step-ms override).
   void set_step(double step_s_new);
 };

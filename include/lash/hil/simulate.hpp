@@ -31,6 +31,7 @@ struct SimulationResult {
   std::vector<MasterStepLog> master;  ///< every master step (connecting step included)
   std::vector<SlaveStepLog> slave;
   std::vector<MasterEvent> events;
+  CompensationState compensation;     ///< the master's scenario compensator at the end (on = false without one)
 };
 
 /// Runs the master's CONNECT step and `control_steps` periods of slave.step(); master.step().
