@@ -132,8 +132,7 @@ void read_compensation(TomlTable& c, ClosedLoopScenario& s) {
 
 // The estimator defaults of each rig (overridable key by key in [compensation.estimator]).
 EstimatorConfig default_estimator(const ClosedLoopScenario& s) {
-  EstimatorConfig e;
-  e.dt_s = s.dt_s;
+  EstimatorConfig e = EstimatorConfig::thesis(ModelKind::deadzone_deadband, s.dt_s);
   if (s.rig == rigs::RigKind::pilot_valve) {
     e.model = ModelKind::input_deadzone;
     // Updates only well beyond the nominal edges: samples near the edge mix deadzone and slope.
