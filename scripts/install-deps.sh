@@ -12,6 +12,7 @@ packages=(
   libmatio-dev zlib1g-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev gnuplot-nox valgrind
+  rt-tests  # cyclictest, the peer of bench/latency_vs_cyclictest.py
   iproute2 util-linux
   # python oracles (Debian's /usr/bin/python3)
   python3 python3-numpy python3-scipy python3-statsmodels python3-can

@@ -44,6 +44,10 @@ int run(const CLI::App& sub, const EstimateOptions& o) {
   // settings are checked before the data is read, so a bad option never costs a file scan
   const EstimationJob job = resolve_settings(src).job;
   const Record rec = load_record(o.data, job.columns, o.strict);
+  if (src.nrmse_window_s && !rec.t().empty() && job.nrmse_t0_s >= rec.t().back())
+    throw InputError(o.data, 0, "--nrmse-window",
+                     "T0 = " + format_double(job.nrmse_t0_s) + " s is not before the record's end (" +
+                         format_double(rec.t().back()) + " s)");
   const EstimateSettings set = resolve_settings(src, rec.dt_s, rec.v(), rec.y());
   const EstimatorConfig& cfg = set.cfg;
   const bool keep = !o.out.empty() || !o.plot.empty();

@@ -6,6 +6,7 @@
 
 #include "cmd_hil.hpp"
 #include "lash/hil/report.hpp"
+#include "lash/hil/schedule.hpp"
 #include "lash/hil/session.hpp"
 #include "lash/hil/simulate.hpp"
 
@@ -31,6 +32,7 @@ struct SimulateOptions {
   std::string reference = "step:from=500,to=1500,time=1";
   std::int64_t seed = -1;
   std::string out = "hil_sim.csv";
+  std::string schedule, slave_schedule;
 };
 
 void print_node(const char* who, const hil::NodeFigures& n) {
@@ -85,6 +87,12 @@ void print_report(const hil::RunReport& r) {
   fmt::print("max |emulation - simulation|: {} kPa, {} mA over {} steps ({} steps used an off-schedule frame)\n",
              format_double(r.vs_simulation.max_abs_diff_kPa), format_double(r.vs_simulation.max_abs_diff_mA),
              r.vs_simulation.compared, r.off_schedule);
+  if (r.vs_observed_schedule)
+    fmt::print("max |emulation - simulation of the observed schedule|: {} kPa, {} mA over {} steps\n",
+               format_double(r.vs_observed_schedule->max_abs_diff_kPa),
+               format_double(r.vs_observed_schedule->max_abs_diff_mA), r.vs_observed_schedule->compared);
+  else
+    fmt::print("observed schedule: {}\n", r.observed_schedule_note);
   fmt::print("logs in {}/ (master.csv, master.events.csv, master_bus.log, slave.csv, slave.events.csv, *.json, "
              "report.json)\n",
              r.out_dir);
@@ -129,8 +137,22 @@ int run_simulate(const SimulateOptions& o) {
   const hil::BenchLayout L = hil::BenchLayout::from_dbc(s.dbc_file);
   const hil::SlaveConfig sc = hil::slave_config(s, L);
   const hil::MasterConfig mc = hil::master_config(s, o.reference);
-  const std::size_t N = hil::steps_for(o.duration, s.step_s, "--duration");
-  const hil::SimulationResult sim = hil::simulate_bench(L, mc, sc, N);
+  std::size_t N = 0;
+  hil::SimulationResult sim;
+  if (o.schedule.empty()) {
+    N = hil::steps_for(o.duration, s.step_s, "--duration");
+    sim = hil::simulate_bench(L, mc, sc, N);
+  } else {  // the run's own schedule: as many control steps as master.csv holds
+    const std::filesystem::path mpath(o.schedule);
+    const std::filesystem::path spath =
+        o.slave_schedule.empty() ? mpath.parent_path() / "slave.csv" : std::filesystem::path(o.slave_schedule);
+    const hil::FrameSchedule fs = hil::read_schedule(mpath, spath);
+    sim = hil::simulate_bench(L, mc, sc, fs);
+    N = std::min(fs.master.size(), sim.slave.size());
+    const hil::SimulationDiff d = hil::compare_with_simulation(hil::read_master_trace(mpath), sim.master);
+    fmt::print("schedule of {} ({} control steps): max |log - simulation| {} kPa, {} mA over {} steps\n", o.schedule,
+               fs.master.size(), format_double(d.max_abs_diff_kPa), format_double(d.max_abs_diff_mA), d.compared);
+  }
   std::vector<double> c_m, c_t, c_r, c_y, c_i, c_p;
   for (std::size_t m = 0; m < N; ++m) {
     const auto& ml = sim.master[m + 1];
@@ -181,6 +203,15 @@ void add_hil_run(CLI::App* hil, std::function<int()>& run_selected) {
   sim->add_option("--seed", sio->seed, "Noise seed of the plant (-1 = from the settings)")
       ->check(CLI::Range(std::int64_t{-1}, INT64_MAX));
   sim->add_option("-o,--output", sio->out, "Output CSV");
+  sim->add_option("--schedule", sio->schedule,
+                  "Replay the frame schedule a run logged: its master.csv (sensor_seq); runs as many control steps "
+                  "as it holds (--duration unused) and prints the largest difference from the log [kPa, mA]")
+      ->check(CLI::ExistingFile);
+  auto* sched = sim->get_option("--schedule");
+  sim->add_option("--slave-schedule", sio->slave_schedule,
+                  "The run's slave.csv (command_counter, command_fresh); default: slave.csv beside --schedule")
+      ->check(CLI::ExistingFile)
+      ->needs(sched);
 
   run_selected = [=]() -> int {
     if (run->parsed()) return run_run(*ro);

@@ -5,6 +5,7 @@
 
 #include "cli_common.hpp"
 #include "plot.hpp"
+#include "lash/io/atomic_file.hpp"
 #include "lash/identify/step_fit.hpp"
 
 namespace lash::cli {
@@ -20,6 +21,12 @@ struct Options {
 };
 
 int run(const Options& o) {
+  // Options before any work.
+  if (!(o.settle_taus > 0 && o.settle_taus <= 100))
+    throw InputError("", 0, "--settle-taus", "must be in (0, 100] [time constants]");
+  if (!(o.tolerance > 0 && o.tolerance <= 1e4))
+    throw InputError("", 0, "--current-tolerance", "must be in (0, 10000] [mA]");
+  if (!o.plot.empty()) check_output_path(o.plot, "--plot");
   const Table tab = read_csv(o.data);
   const auto& t = tab[o.t_col];
   const auto& cur = tab[o.i_col];
@@ -88,8 +95,9 @@ Command add_identify_steps(CLI::App& app) {
   sub->add_option("--time-column", o->t_col, "Time column [s]");
   sub->add_option("--current-column", o->i_col, "Current column [mA]");
   sub->add_option("--pressure-column", o->p_col, "Pressure column [kPa]");
-  sub->add_option("--settle-taus", o->settle_taus, "Steady part starts this many tau after a step");
-  sub->add_option("--current-tolerance", o->tolerance, "Current change that starts a new segment [mA]");
+  sub->option_defaults()->always_capture_default();
+  sub->add_option("--settle-taus", o->settle_taus, "Steady part starts this many tau after a step, (0, 100]");
+  sub->add_option("--current-tolerance", o->tolerance, "Current change that starts a new segment [mA], (0, 10000]");
   sub->add_flag("--json", o->json, "Print one JSON object");
   sub->add_option("--plot", o->plot, "Render time history and steady pressure vs current to a PNG");
   return {sub, [o] { return run(*o); }};

@@ -10,6 +10,7 @@
 #include <fmt/core.h>
 
 #include "cli_common.hpp"
+#include "lash/io/atomic_file.hpp"
 #include "plot.hpp"
 #include "lash/experiments/campaign.hpp"
 #include "lash/experiments/sweep.hpp"
@@ -33,7 +34,7 @@ void write_trace(const sweep::Campaign& c, const std::vector<std::string>& arg) 
   try {
     std::size_t used = 0;
     const unsigned long long v = std::stoull(arg[0], &used);
-    if (used != arg[0].size()) throw std::invalid_argument(arg[0]);
+    if (used != arg[0].size() || arg[0].find('-') != std::string::npos) throw std::invalid_argument(arg[0]);
     idx = static_cast<std::size_t>(v);
   } catch (const std::exception&) {
     throw InputError("", 0, "--trace", "RUN must be a run number (column 'run' of the results), got '" + arg[0] + "'");
@@ -133,6 +134,10 @@ void plot_sweep(const sweep::Campaign& c, const std::vector<sweep::RunResult>& r
 
 int run(const SweepOptions& o) {
   const sweep::Campaign c = sweep::load_campaign(o.campaign);
+  // Every output is checked before any run.
+  check_output_path(o.out, "--output");
+  if (!o.plot.empty()) check_output_path(o.plot, "--plot");
+  if (!o.trace.empty()) check_output_path(o.trace[1], "--trace");
   if (!o.trace.empty()) {
     write_trace(c, o.trace);
     if (!o.quiet) fmt::print(stderr, "trace of run {} -> {}\n", o.trace[0], o.trace[1]);
@@ -181,7 +186,8 @@ Command add_sweep(CLI::App& app) {
   auto o = std::make_shared<SweepOptions>();
   auto* sub = app.add_subcommand("sweep", "Run a campaign of virtual-rig runs (E3-E5) in parallel and report NRMSE");
   sub->add_option("campaign", o->campaign, "Campaign file (TOML, see docs/sweep.md)")->required();
-  sub->add_option("-j,--jobs", o->jobs, "Worker threads (default: all cores)");
+  sub->add_option("-j,--jobs", o->jobs, "Worker threads, 0..1024 (0 = all cores)")
+      ->check(CLI::Range(0u, 1024u));
   sub->add_option("-o,--output", o->out, "Results CSV, one row per run")->required();
   sub->add_option("--plot", o->plot, "Also draw NRMSE against amplitude/frequency per waveform (PNG, gnuplot)");
   sub->add_flag("--json", o->json, "Print the summary as JSON");

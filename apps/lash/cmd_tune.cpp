@@ -1,8 +1,11 @@
 // lash tune: reproducible search for PID gains matching step-response targets (tune.hpp).
+#include <cmath>
+
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
 #include "cli_common.hpp"
+#include "lash/io/atomic_file.hpp"
 #include "lash/control/gains_file.hpp"
 #include "lash/experiments/tune.hpp"
 
@@ -15,7 +18,7 @@ struct Options {
   double r0 = 0.0, r1 = 1000.0;
   int samples = 30000, restarts = 16;
   bool tune_filter = false;
-  std::uint64_t seed = 1;
+  std::int64_t seed = 1;
   bool json = false;
   std::string out;
 };
@@ -29,6 +32,10 @@ int run(const Options& o) {
   } catch (const std::invalid_argument& e) {
     throw InputError("", 0, o.weights.empty() ? "--target" : "--target/--weights", e.what());
   }
+  if (!std::isfinite(o.r0)) throw InputError("", 0, "--r0", "must be a finite pressure [kPa]");
+  if (!std::isfinite(o.r1)) throw InputError("", 0, "--r1", "must be a finite pressure [kPa]");
+  if (o.r0 == o.r1) throw InputError("", 0, "--r1", "must differ from --r0 (a step needs two levels)");
+  if (!o.out.empty()) check_output_path(o.out, "--output");
   if (o.samples < 1) throw InputError("", 0, "--samples", "must be >= 1");
   if (o.restarts < 1) throw InputError("", 0, "--restarts", "must be >= 1");
   t.step.r0_kPa = o.r0;
@@ -36,7 +43,7 @@ int run(const Options& o) {
   t.samples = o.samples;
   t.restarts = o.restarts;
   t.tune_filter = o.tune_filter;
-  t.seed = o.seed;
+  t.seed = static_cast<std::uint64_t>(o.seed);
   const TuneResult r = tune_pid(t);
   ControllerConfig c = t.controller;
   c.pid.gains = r.gains;
@@ -84,16 +91,19 @@ int run(const Options& o) {
 Command add_tune(CLI::App& app) {
   auto o = std::make_shared<Options>();
   auto* sub = app.add_subcommand("tune", "Search PID gains whose discrete step response matches targets (reproducible)");
+  sub->option_defaults()->always_capture_default();
   sub->add_option("--target", o->target, "rise=S,settling=S,overshoot=PCT[,ode3_overshoot=PCT]");
   sub->add_option("--weights", o->weights, "rise=W,settling=W,overshoot=W,ode3=W (default 1,0.1,1,0.1)");
-  sub->add_option("--r0", o->r0, "Step from [kPa]");
-  sub->add_option("--r1", o->r1, "Step to [kPa]");
-  sub->add_option("--samples", o->samples, "Random samples of the gain box");
-  sub->add_option("--restarts", o->restarts, "Nelder-Mead restarts from the best samples");
+  sub->add_option("--r0", o->r0, "Step from [kPa], finite, != --r1");
+  sub->add_option("--r1", o->r1, "Step to [kPa], finite, != --r0");
+  sub->add_option("--samples", o->samples, "Random samples of the gain box, 1..10000000")
+      ->check(CLI::Range(1, 10'000'000));
+  sub->add_option("--restarts", o->restarts, "Nelder-Mead restarts from the best samples, 1..10000")
+      ->check(CLI::Range(1, 10'000));
   sub->add_flag("--tune-filter", o->tune_filter, "Also search the derivative filter N (default N = 0)");
-  sub->add_option("--seed", o->seed, "Search seed");
+  sub->add_option("--seed", o->seed, "Search seed, >= 0")->check(CLI::Range(std::int64_t{0}, INT64_MAX));
   sub->add_flag("--json", o->json, "Print one JSON object");
-  sub->add_option("-o,--output", o->out, "Write the gains as a controller TOML");
+  sub->add_option("-o,--output", o->out, "Write the gains as a controller TOML (checked before the search)");
   return {sub, [o] { return run(*o); }};
 }
 

@@ -80,7 +80,8 @@ SettingsSources settings_sources(const CLI::App& sub, const EstimateOptions& o) 
   }
   if (!o.columns.empty()) s.columns = split_names(o.columns);
   if (!o.nrmse_window.empty()) {
-    if (o.nrmse_window.size() != 2) throw InputError("", 0, "--nrmse-window", "expected T0 T1 with T0 < T1 [s]");
+    if (o.nrmse_window.size() != 2)
+      throw InputError("", 0, "--nrmse-window", "expected T0 T1 with 0 <= T0 < T1, finite [s]");
     s.nrmse_window_s = std::pair{o.nrmse_window[0], o.nrmse_window[1]};
   }
   return s;

@@ -294,7 +294,7 @@ void write_slave_csv(const std::filesystem::path& path, const SlaveRun& r) {
 }
 
 void write_master_csv(const std::filesystem::path& path, const MasterRun& r) {
-  std::vector<std::vector<double>> c(15);
+  std::vector<std::vector<double>> c(16);
   const std::size_t n = std::min(r.log.size(), r.loop.records.size());
   for (std::size_t i = 0; i < n; ++i) {
     const auto& l = r.log[i];
@@ -302,14 +302,14 @@ void write_master_csv(const std::filesystem::path& path, const MasterRun& r) {
     const double row[] = {static_cast<double>(l.step), static_cast<double>(rec.release_ns) * 1e-9,
                           static_cast<double>(l.state), static_cast<double>(l.control_step), l.reference_kPa,
                           l.measured_kPa, static_cast<double>(l.sensor_counter), l.sensor_fresh ? 1.0 : 0.0,
-                          static_cast<double>(l.dropped), l.current_mA, l.integrator_mA,
+                          static_cast<double>(l.sensor_seq), static_cast<double>(l.dropped), l.current_mA, l.integrator_mA,
                           l.command_sent ? static_cast<double>(l.command_counter) : -1.0,
                           us(rec.tet_ns), us(rec.io_ns), us(rec.wake_latency_ns)};
     for (std::size_t j = 0; j < c.size(); ++j) c[j].push_back(row[j]);
   }
   write_columns(path,
                 {"step", "t_s", "state", "control_step", "reference_kPa", "measured_kPa", "sensor_counter",
-                 "sensor_fresh", "dropped", "current_mA", "integrator_mA", "command_counter", "tet_us", "io_us",
+                 "sensor_fresh", "sensor_seq", "dropped", "current_mA", "integrator_mA", "command_counter", "tet_us", "io_us",
                  "wake_latency_us"},
                 c);
 }

@@ -324,6 +324,7 @@ bool MasterNode::step(can::Bus& bus, double now_s) noexcept {
     l.measured_kPa = measured_kPa_;
     l.sensor_counter = sensor_counter_;
     l.sensor_fresh = fresh_;
+    l.sensor_seq = fresh_ ? static_cast<std::int64_t>(sens_.extended) : -1;
     l.dropped = dropped;
     l.current_mA = send_cmd ? current_mA_ : 0.0;
     l.integrator_mA = controller_.pid().integrator();

@@ -234,6 +234,14 @@ std::string run_report_json(const RunReport& r) {
     out["compared_steps"] = r.vs_simulation.compared;
     if (r.vs_simulation.first_diff_step) out["first_diff_control_step"] = *r.vs_simulation.first_diff_step;
     out["off_schedule_steps"] = r.off_schedule;
+    if (r.vs_observed_schedule) {
+      out["max_abs_diff_vs_observed_schedule_kPa"] = r.vs_observed_schedule->max_abs_diff_kPa;
+      out["max_abs_diff_vs_observed_schedule_mA"] = r.vs_observed_schedule->max_abs_diff_mA;
+      out["observed_schedule_compared_steps"] = r.vs_observed_schedule->compared;
+    } else {
+      out["max_abs_diff_vs_observed_schedule_kPa"] = nullptr;
+      out["observed_schedule_note"] = r.observed_schedule_note;
+    }
   }
   out["out_dir"] = r.out_dir;
   return out.dump(2) + "\n";

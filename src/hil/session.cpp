@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "lash/hil/netns.hpp"
+#include "lash/hil/schedule.hpp"
 #include "lash/hil/simulate.hpp"
 #include "lash/io/atomic_file.hpp"
 #include "lash/io/csv.hpp"
@@ -328,6 +329,18 @@ RunReport Session::run(const std::function<void(const std::string&)>& progress) 
   if (have_master && mrun.stats.control_steps > 0)
     simulated = simulate_bench(L, mc, sc, static_cast<std::size_t>(mrun.stats.control_steps)).master;
   make_run_report(rep, have_master ? &mrun : nullptr, sruns, simulated);
+  if (!simulated.empty()) {  // the same closed loop, fed the frames each node logged it used
+    if (sruns.size() != 1 || sruns[0].log.empty()) {
+      rep.observed_schedule_note = "not replayed: the schedule of one slave from start to end is needed";
+    } else {
+      try {
+        const FrameSchedule fs = observed_schedule(mrun.log, sruns[0].log);
+        rep.vs_observed_schedule = compare_with_simulation(mrun.log, simulate_bench(L, mc, sc, fs).master);
+      } catch (const std::invalid_argument& e) {
+        rep.observed_schedule_note = std::string("not replayed: ") + e.what();
+      }
+    }
+  }
   AtomicFile f(dir / "report.json");
   f.stream() << run_report_json(rep);
   f.commit();

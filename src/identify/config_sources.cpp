@@ -1,5 +1,6 @@
 #include "lash/identify/config_sources.hpp"
 
+#include <cmath>
 #include <stdexcept>
 
 #include "lash/identify/config_fields.hpp"
@@ -91,8 +92,9 @@ EstimateSettings resolve_settings(const SettingsSources& src, double dt_s, std::
     out.job.columns = *src.columns;
   }
   if (src.nrmse_window_s) {
-    if (!(src.nrmse_window_s->first < src.nrmse_window_s->second))
-      throw InputError("", 0, "--nrmse-window", "expected T0 T1 with T0 < T1 [s]");
+    const auto [t0, t1] = *src.nrmse_window_s;
+    if (!(t0 >= 0) || !(t0 < t1) || !std::isfinite(t1))
+      throw InputError("", 0, "--nrmse-window", "expected T0 T1 with 0 <= T0 < T1, finite [s]");
     out.job.nrmse_t0_s = src.nrmse_window_s->first;
     out.job.nrmse_t1_s = src.nrmse_window_s->second;
   }

@@ -18,6 +18,20 @@ bool is_stream_output(const std::filesystem::path& path) {
   return !ec && std::filesystem::exists(st) && !std::filesystem::is_regular_file(st);
 }
 
+void check_output_path(const std::filesystem::path& target, const std::string& option) {
+  if (target.empty()) throw InputError("", 0, option, "the output path is empty");
+  std::error_code ec;
+  if (target != "-" && std::filesystem::is_directory(target, ec))
+    throw InputError(target.string(), 0, option, "is a directory, not a file");
+  if (is_stream_output(target)) return;
+  const auto dir = target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
+  if (!std::filesystem::is_directory(dir, ec))
+    throw InputError(target.string(), 0, option, "cannot write: directory " + dir.string() + " does not exist");
+  if (::access(dir.c_str(), W_OK) != 0)
+    throw InputError(target.string(), 0, option,
+                     "cannot write in directory " + dir.string() + ": " + std::strerror(errno));
+}
+
 namespace {
 
 std::string open_failure_reason(const std::filesystem::path& target, const std::filesystem::path& opened) {

@@ -26,6 +26,10 @@ check equal_guesses  "guess-left.*must be < guess-right"          "$good" --gues
 check bad_lambda     "lambda"                                     "$good" --lambda 1.5
 check bad_model      "'--model'.*unknown model"                   "$good" --model gearbox
 check renamed_cols   "renamed_cols.csv:1: 'pos'.*no such column"  "$good" --columns t,v,pos
+# --nrmse-window: 0 <= T0 < T1, T0 inside the record (issue 15 item 5)
+check window_negative "'--nrmse-window'.*0 <= T0 < T1"            "$good" --nrmse-window -5 -1
+check window_reversed "'--nrmse-window'.*0 <= T0 < T1"            "$good" --nrmse-window 2 1
+check window_past_end "window_past_end.csv: '--nrmse-window'.*not before the record's end \(0.015 s\)" "$good" --nrmse-window 5 6
 # a bad config file names its line and key
 printf 'model = "deadzone-deadband"\n[rls]\nlambada = 0.9\n' > "$d/bad.toml"
 printf '%s' "$good" > "$d/ok.csv"

@@ -18,6 +18,19 @@ expect2() {  # expect2 PATTERN ARGS...
 expect2 "--reference" hil simulate --reference bogus:amplitude=1 -o "$tmp/a.csv"
 expect2 "--reference" hil simulate --reference square:amplitude=x -o "$tmp/a.csv"
 expect2 "--duration" hil simulate --duration 0 -o "$tmp/a.csv"
+# --schedule: the run's master.csv / slave.csv (issue 15 item 7); bad logs name file, line, column.
+mkdir -p "$tmp/run"
+printf 'step,control_step,sensor_seq,dropped,measured_kPa,current_mA\n0,-1,-1,0,0,0\n1,0,0,0,0,0\n2,1,1,0,0,0\n' >"$tmp/run/master.csv"
+printf 'step,command_counter,command_fresh,dropped\n0,0,0,0\n1,0,1,0\n' >"$tmp/run/slave.csv"
+expect2 "--schedule" hil simulate --schedule "$tmp/nope.csv" -o "$tmp/a.csv"
+expect2 "--schedule" hil simulate --slave-schedule "$tmp/run/slave.csv" -o "$tmp/a.csv"
+printf 'step,control_step,dropped\n1,0,0\n' >"$tmp/run/noseq.csv"
+cp "$tmp/run/slave.csv" "$tmp/slave.csv"
+expect2 "noseq.csv:1: 'sensor_seq'" hil simulate --schedule "$tmp/run/noseq.csv" --slave-schedule "$tmp/slave.csv" -o "$tmp/a.csv"
+printf 'step,control_step,sensor_seq,dropped,measured_kPa,current_mA\n1,0,0,0,0,0\n2,1,0.5,0,0,0\n' >"$tmp/run/frac.csv"
+expect2 "frac.csv:3: 'sensor_seq'.*integer" hil simulate --schedule "$tmp/run/frac.csv" --slave-schedule "$tmp/slave.csv" -o "$tmp/a.csv"
+printf 'step,command_counter,command_fresh,dropped\n0,0,0,0\n1,0,2,0\n' >"$tmp/run/slave2.csv"
+expect2 "slave2.csv:3: 'command_fresh'.*0 or 1" hil simulate --schedule "$tmp/run/master.csv" --slave-schedule "$tmp/run/slave2.csv" -o "$tmp/a.csv"
 [[ -e "$tmp/a.csv" ]] && fail "output written despite bad input"
 
 write_cfg() {  # write_cfg EXTRA_CONTROLLER_LINE [DTO_LOG]

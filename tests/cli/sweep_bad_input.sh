@@ -31,6 +31,27 @@ check bad_lambda       "bad_lambda.toml:[0-9]+: 'estimator'.*lambda"            
 check bad_rig_value    "bad_rig_value.toml:[0-9]+: 'rig_params'.*mass_kg"         "${head}${matrix}"$'[rig_params]\nmass_kg = -1.0\n'
 check bad_model        "bad_model.toml:[0-9]+: 'estimator.model'"                 "${head}${matrix}"$'[estimator]\nmodel = "quadratic"\n'
 check model_for_rig    "model_for_rig.toml:[0-9]+: 'estimator.model'.*linear.*motor_cart" "${head}${matrix}"$'[estimator]\nmodel = "linear"\n'
+# Options (issue 15 item 5): each bad value -> exit 2 naming the option, before any run (no CSV).
+printf '%s' "${head}${matrix}" > "$d/good.toml"
+opt() {  # name expected-regex args...
+  local name=$1 want=$2; shift 2
+  local out rc
+  out=$("$LASH" sweep "$d/good.toml" -q "$@" 2>&1); rc=$?
+  if [[ $rc -ne 2 ]]; then echo "FAIL $name: exit $rc (want 2): $out"; fail=1; return; fi
+  if ! grep -Eq -- "$want" <<<"$out"; then echo "FAIL $name: message '$out' lacks /$want/"; fail=1; return; fi
+  if [[ -e $d/opt.csv ]]; then echo "FAIL $name: output file left behind"; fail=1; rm -f "$d/opt.csv"; return; fi
+  echo "ok   $name: $out"
+}
+opt jobs_negative  "jobs"                                   -j -1 -o "$d/opt.csv"
+opt jobs_huge      "jobs.*1024"                             -j 100000 -o "$d/opt.csv"
+opt jobs_text      "jobs"                                   -j many -o "$d/opt.csv"
+opt out_no_dir     "'--output'.*directory $d/nodir does not exist" -o "$d/nodir/x.csv"
+opt out_is_dir     "'--output'.*is a directory"             -o "$d"
+opt plot_no_dir    "'--plot'.*directory $d/nodir does not exist" -o "$d/opt.csv" --plot "$d/nodir/x.png"
+opt trace_no_dir   "'--trace'.*directory $d/nodir does not exist" -o "$d/opt.csv" --trace 0 "$d/nodir/t.csv"
+opt trace_no_run   "'--trace'.*run 7 does not exist"        -o "$d/opt.csv" --trace 7 "$d/t.csv"
+opt trace_bad_run  "'--trace'.*RUN must be a run number"    -o "$d/opt.csv" --trace -1 "$d/t.csv"
+"$LASH" sweep --help | grep -q -- "0..1024 (0 = all cores)" && echo "ok   --help shows the --jobs limits" || { echo "FAIL --help lacks the --jobs limits"; fail=1; }
 out=$("$LASH" sweep "$d/nope.toml" -q -o "$d/x.csv" 2>&1); rc=$?
 [[ $rc -eq 2 && $out == *"nope.toml: no such file"* && ! -e $d/x.csv ]] || { echo "FAIL missing file: $rc $out"; fail=1; }
 exit $fail

@@ -211,6 +211,8 @@ struct MasterStepLog {
   double measured_kPa = 0.0;               ///< decoded sensor (held when no fresh frame)
   std::uint16_t sensor_counter = 0;
   bool sensor_fresh = false;               ///< a plausible new sensor frame arrived for this step
+  std::int64_t sensor_seq = -1;            ///< the sensor frame used: its counter unwrapped (= the slave step
+                                           ///< that sent it); −1 = none new, the value is held (schedule.hpp)
   std::uint16_t dropped = 0;               ///< implausible sensor frames dropped in this step
   double current_mA = 0.0;                 ///< commanded (before bus quantisation)
   double integrator_mA = 0.0;              ///< the PID's integrator state after the step [mA]

@@ -108,6 +108,10 @@ struct RunReport {
   FrameStats frames;                      ///< sent/received/late/lost summed over master + every slave
   std::optional<StepResponse> step;
   SimulationDiff vs_simulation;           ///< against the ideal-schedule simulation
+  /// Against the simulation of the schedule the nodes logged (schedule.hpp): 0 for every run,
+  /// late frames or not. Empty when it was not replayed (why: observed_schedule_note).
+  std::optional<SimulationDiff> vs_observed_schedule;
+  std::string observed_schedule_note;
   std::size_t off_schedule = 0;
 };
 

@@ -11,6 +11,7 @@
 /// name `-` means standard output. Those outputs are streams, so "whole or
 /// nothing" cannot hold for them. Not real-time safe.
 #include <filesystem>
+#include <string>
 #include <fstream>
 #include <ostream>
 
@@ -48,5 +49,10 @@ class AtomicFile {
 /// True if `path` names standard output (`-`) or an existing file that is not
 /// a regular file (device, FIFO, socket): outputs that must be written in place.
 bool is_stream_output(const std::filesystem::path& path);
+
+/// Checks, before any work, that an AtomicFile on `target` can be created: `-` and existing
+/// stream outputs pass; otherwise the target must not be a directory and its directory must
+/// exist and be writable. Throws InputError(target, 0, option, reason).
+void check_output_path(const std::filesystem::path& target, const std::string& option);
 
 }  // namespace lash

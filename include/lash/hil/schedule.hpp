@@ -1,0 +1,67 @@
+#pragma once
+/// @file schedule.hpp
+/// Which frame each node used at each step, and the closed-loop simulation that replays it
+/// (`lash hil simulate --schedule master.csv`, and report.json's
+/// `max_abs_diff_vs_observed_schedule_kPa`).
+///
+/// The ideal schedule is the one of simulate_bench (simulate.hpp): master control step m uses
+/// the sensor frame of slave step m, slave step s the command of master control step s − 1.
+/// A real run departs from it when a frame is late (a node stalled, the host was busy): the
+/// master then holds the last value for that step and catches up with a newer frame later,
+/// skipping one; a stalled slave runs its late steps back to back, the first taking the newest
+/// of the queued commands, the next ones none. The nodes log what they used (master.csv
+/// `sensor_seq`, slave.csv `command_counter` where `command_fresh` = 1), and the replay feeds
+/// each simulated node exactly those frames at those steps, through the nodes' own step
+/// functions, so that the replay equals the emulation sample for sample, late frames or not.
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+#include "lash/hil/nodes.hpp"
+#include "lash/hil/simulate.hpp"
+
+namespace lash::hil {
+
+/// What one node applied at one step.
+struct FrameUse {
+  /// The frame applied at this step, named by the step of its sender that sent it (master:
+  /// the slave step of the sensor frame; slave: the control step of the command); −1 = no new
+  /// frame this step (the node held the previous value or ran its safe-state machine).
+  std::int64_t seq = -1;
+  bool dropped = false;  ///< an implausible frame was dropped in this step (drives degraded)
+};
+
+/// The frames both nodes used, step by step.
+struct FrameSchedule {
+  std::vector<FrameUse> master;  ///< by control step m = 0, 1, …
+  std::vector<FrameUse> slave;   ///< by slave step s = 0, 1, …
+};
+
+/// The schedule of simulate_bench: master m uses slave frame m, slave s uses command s − 1.
+FrameSchedule ideal_schedule(std::size_t control_steps);
+
+/// The schedule the nodes logged in a run (control steps of the master log, every slave step).
+/// The master's `sensor_seq` is the sensor frame's alive counter unwrapped (= the slave step
+/// that sent it), the slave's `command_counter` the command's counter unwrapped (= the control step).
+FrameSchedule observed_schedule(const std::vector<MasterStepLog>& master, const std::vector<SlaveStepLog>& slave);
+
+/// Reads the schedule of a run from its logs: master.csv (columns control_step, sensor_seq,
+/// dropped) and slave.csv (command_counter, command_fresh, dropped). Throws InputError naming
+/// the file, line and column of a missing column or a value that is not a step number.
+FrameSchedule read_schedule(const std::filesystem::path& master_csv, const std::filesystem::path& slave_csv);
+
+/// The control steps of a master.csv as a master log (control_step, measured_kPa, current_mA
+/// filled; the rows before the handshake skipped), to compare with a simulation. Throws InputError.
+std::vector<MasterStepLog> read_master_trace(const std::filesystem::path& master_csv);
+
+/// The closed loop of simulate_bench, with each node fed at each step exactly the frames of
+/// `schedule` (every frame of its sender newer than the last one it used, up to the one it
+/// used — what it received — and, where the log says a frame was dropped, one implausible
+/// frame (wrong DLC) besides). Runs schedule.master.size() control steps and the slave steps
+/// they need. Throws std::invalid_argument when the schedule is not causal (a node uses a frame
+/// its sender has not sent yet, or an older one than before), naming the step.
+SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& master, const SlaveConfig& slave,
+                                const FrameSchedule& schedule);
+
+}  // namespace lash::hil

@@ -1,0 +1,208 @@
+// The observed-schedule replay (hil/schedule.hpp): a hand-made schedule with a frame used
+// twice, a skipped frame, a late command and a dropped frame, against a hand-written discrete
+// loop (plant, controller and reference stepped directly, no node code); identities with the
+// ideal-schedule simulation; non-causal schedules and bad schedule files refused.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <unistd.h>
+
+#include "lash/hil/report.hpp"
+#include "lash/hil/schedule.hpp"
+#include "lash/io/error.hpp"
+
+using namespace lash;
+using namespace lash::hil;
+
+namespace {
+
+can::Frame recorded_dto() {
+  can::Frame f;
+  f.id = 0x7E1;
+  f.len = 8;
+  const std::uint8_t bytes[8] = {0xFF, 0x00, 0x00, 0x21, 0x07, 0x5A, 0x00, 0x03};
+  for (int i = 0; i < 8; ++i) f.data[static_cast<std::size_t>(i)] = bytes[i];
+  return f;
+}
+
+constexpr double kT = 0.005;
+
+MasterConfig master_cfg() {
+  MasterConfig m;
+  m.controller.pid.dt_s = kT;
+  m.controller.pid.gains.kp = 1.2;
+  m.controller.pid.gains.ki_per_s = 12.0;
+  m.controller.pid.gains.kd_s = 0.004;
+  m.reference.kind = Waveform::square;
+  m.reference.amplitude = 400.0;
+  m.reference.offset = 900.0;
+  m.reference.frequency_rad_s = std::numbers::pi;
+  return m;
+}
+
+SlaveConfig slave_cfg() {
+  SlaveConfig s;
+  s.plant.dt_s = kT;
+  s.plant.seed = 7;
+  s.dto_reply = {recorded_dto()};
+  return s;
+}
+
+void expect_same(const SimulationResult& a, const SimulationResult& b) {
+  ASSERT_EQ(a.master.size(), b.master.size());
+  ASSERT_GE(a.slave.size(), b.slave.size());
+  for (std::size_t k = 0; k < a.master.size(); ++k) {
+    ASSERT_EQ(a.master[k].control_step, b.master[k].control_step) << k;
+    ASSERT_EQ(a.master[k].measured_kPa, b.master[k].measured_kPa) << k;
+    ASSERT_EQ(a.master[k].current_mA, b.master[k].current_mA) << k;
+    ASSERT_EQ(a.master[k].state, b.master[k].state) << k;
+  }
+  for (std::size_t s = 0; s < b.slave.size(); ++s) ASSERT_EQ(a.slave[s].pressure_kPa, b.slave[s].pressure_kPa) << s;
+}
+
+}  // namespace
+
+TEST(HilSchedule, IdealScheduleEqualsSimulateBench) {
+  const std::size_t N = 600;
+  BenchLayout L;
+  const SimulationResult ideal = simulate_bench(L, master_cfg(), slave_cfg(), N);
+  const SimulationResult replay = simulate_bench(L, master_cfg(), slave_cfg(), ideal_schedule(N));
+  expect_same(replay, ideal);
+  // The schedule the simulated nodes logged is the ideal one: sensor_seq = control step.
+  const FrameSchedule seen = observed_schedule(ideal.master, ideal.slave);
+  const FrameSchedule want = ideal_schedule(N);
+  ASSERT_EQ(seen.master.size(), N);
+  ASSERT_GE(seen.slave.size(), N);
+  for (std::size_t k = 0; k < N; ++k) {
+    ASSERT_EQ(seen.master[k].seq, want.master[k].seq) << k;
+    ASSERT_EQ(seen.slave[k].seq, want.slave[k].seq) << k;
+    ASSERT_FALSE(seen.master[k].dropped || seen.slave[k].dropped) << k;
+  }
+}
+
+TEST(HilSchedule, LateAndSkippedFramesEqualHandWrittenLoop) {
+  const std::size_t N = 400;
+  FrameSchedule sch = ideal_schedule(N);
+  // Master: sensor frame 50 late (the value of frame 49 is used at control steps 49 and 50),
+  // then frame 51 at 51: frame 50 skipped. Frame 80 used one step late, at 81; frame 81 skipped.
+  sch.master[50].seq = -1;
+  sch.master[80].seq = -1;
+  sch.master[81].seq = 80;
+  // Slave: command 119 late, 120 arrives with it at slave step 121: 119 skipped, 118 held at 120.
+  sch.slave[120].seq = -1;
+  BenchLayout L;
+  const SimulationResult sim = simulate_bench(L, master_cfg(), slave_cfg(), sch);
+  ASSERT_EQ(sim.master.size(), N + 1);
+
+  // By hand: slave step k applies the command it used (held if none) and measures; master
+  // step k uses the sensor frame of slave step U(k) (holds value and command if none).
+  PilotValvePlant plant(slave_cfg().plant);
+  ClosedLoopDiscrete ctl(master_cfg().controller);
+  Signal ref(master_cfg().reference, kT);
+  std::vector<double> y_sent(N), i_sent(N);
+  double c = 0.0, y = 0.0, i = 0.0;
+  for (std::size_t k = 0; k < N; ++k) {
+    if (k > 0) {
+      if (sch.slave[k].seq >= 0) c = L.quantize_current(i_sent[static_cast<std::size_t>(sch.slave[k].seq)]);
+      plant.apply(c);
+    }
+    plant.measure();
+    y_sent[k] = decode_pressure_raw(plant.last_raw());
+    const double r = ref.next();
+    if (sch.master[k].seq >= 0) {
+      y = y_sent[static_cast<std::size_t>(sch.master[k].seq)];
+      i = ctl.step(r, y);
+    }
+    i_sent[k] = i;
+    const MasterStepLog& m = sim.master[k + 1];
+    ASSERT_EQ(m.control_step, static_cast<std::int64_t>(k));
+    ASSERT_EQ(m.state, MasterState::running) << k;
+    ASSERT_EQ(m.measured_kPa, y) << k;
+    ASSERT_EQ(m.current_mA, i) << k;
+    ASSERT_EQ(m.sensor_seq, sch.master[k].seq) << k;
+    ASSERT_EQ(sim.slave[k].current_mA, c) << k;
+  }
+  // The frame used twice and the skipped ones by value: held at 50 and 80, frame 80 at 81.
+  EXPECT_EQ(sim.master[51].measured_kPa, y_sent[49]);
+  EXPECT_EQ(sim.master[51].current_mA, sim.master[50].current_mA);
+  EXPECT_EQ(sim.master[82].measured_kPa, y_sent[80]);
+  EXPECT_EQ(sim.master[83].measured_kPa, y_sent[82]);
+  EXPECT_EQ(sim.slave[120].current_mA, sim.slave[119].current_mA);
+  EXPECT_EQ(sim.slave[121].current_mA, L.quantize_current(i_sent[120]));
+  // And it is not the ideal schedule's trace (the comparison can fail).
+  const SimulationResult ideal = simulate_bench(L, master_cfg(), slave_cfg(), N);
+  const SimulationDiff d = compare_with_simulation(sim.master, ideal.master);
+  EXPECT_GT(d.max_abs_diff_kPa, 0.0);
+  ASSERT_TRUE(d.first_diff_step.has_value());
+  EXPECT_EQ(*d.first_diff_step, 50);
+}
+
+TEST(HilSchedule, DroppedFrameDegradesAtItsStep) {
+  const std::size_t N = 100;
+  FrameSchedule sch = ideal_schedule(N);
+  sch.master[60].dropped = true;  // an implausible sensor frame besides frame 60
+  BenchLayout L;
+  const SimulationResult sim = simulate_bench(L, master_cfg(), slave_cfg(), sch);
+  // Control step m is row m + 1: running until 59, degraded at 60 with the integrator frozen,
+  // running again after recovery_frames (5) good steps: 61..65.
+  EXPECT_EQ(sim.master[60].state, MasterState::running);
+  EXPECT_EQ(sim.master[61].state, MasterState::degraded);
+  EXPECT_EQ(sim.master[61].integrator_mA, sim.master[60].integrator_mA);
+  EXPECT_EQ(sim.master[61].dropped, 1);
+  EXPECT_EQ(sim.master[65].state, MasterState::degraded);
+  EXPECT_EQ(sim.master[66].state, MasterState::running);
+}
+
+TEST(HilSchedule, NonCausalSchedulesAreRefused) {
+  BenchLayout L;
+  FrameSchedule ahead = ideal_schedule(50);
+  ahead.master[10].seq = 11;   // a sensor frame from the slave step after it
+  ahead.slave[11].seq = 11;    // …which needs the command of control step 11
+  EXPECT_THROW(simulate_bench(L, master_cfg(), slave_cfg(), ahead), std::invalid_argument);
+  FrameSchedule back = ideal_schedule(50);
+  back.master[20].seq = 19;    // frame 19 again
+  EXPECT_THROW(simulate_bench(L, master_cfg(), slave_cfg(), back), std::invalid_argument);
+  FrameSchedule short_slave = ideal_schedule(50);
+  short_slave.slave.resize(30);  // the master uses frames the slave never sent
+  EXPECT_THROW(simulate_bench(L, master_cfg(), slave_cfg(), short_slave), std::invalid_argument);
+}
+
+TEST(HilSchedule, ReadScheduleFromLogs) {
+  const auto dir = std::filesystem::temp_directory_path() / ("lash_sched_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream m(dir / "master.csv");
+    m << "step,control_step,sensor_seq,dropped,measured_kPa,current_mA\n"
+         "0,-1,-1,0,0,0\n1,0,0,0,1,2\n2,1,-1,1,1,2\n3,2,2,0,3,4\n";
+    std::ofstream s(dir / "slave.csv");
+    s << "step,command_counter,command_fresh,dropped\n0,0,0,0\n1,0,1,0\n2,0,1,0\n3,2,1,1\n";
+  }
+  const FrameSchedule fs = read_schedule(dir / "master.csv", dir / "slave.csv");
+  ASSERT_EQ(fs.master.size(), 3u);
+  EXPECT_EQ(fs.master[0].seq, 0);
+  EXPECT_EQ(fs.master[1].seq, -1);
+  EXPECT_TRUE(fs.master[1].dropped);
+  EXPECT_EQ(fs.master[2].seq, 2);
+  ASSERT_EQ(fs.slave.size(), 4u);
+  EXPECT_EQ(fs.slave[0].seq, -1);
+  EXPECT_EQ(fs.slave[1].seq, 0);
+  EXPECT_EQ(fs.slave[3].seq, 2);
+  EXPECT_TRUE(fs.slave[3].dropped);
+  const auto trace = read_master_trace(dir / "master.csv");
+  ASSERT_EQ(trace.size(), 3u);
+  EXPECT_EQ(trace[2].measured_kPa, 3.0);
+  {
+    std::ofstream m(dir / "master.csv");
+    m << "step,control_step,sensor_seq,dropped\n0,0,0,0\n1,1,0.5,0\n";
+  }
+  try {
+    read_schedule(dir / "master.csv", dir / "slave.csv");
+    ADD_FAILURE() << "a fractional sensor_seq was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.line(), 3);
+    EXPECT_EQ(e.field(), "sensor_seq");
+  }
+  std::filesystem::remove_all(dir);
+}
