@@ -57,6 +57,14 @@ int run_closed_loop_scenario_cmd(const std::string& path, const std::string& com
                        {"estimator_reason", r.estimator_reason},
                        {"dither_amplitude", s.adaptation.dither_amplitude},
                        {"dither_period_s", s.adaptation.dither_period_s}};
+    // The estimator inside the adaptive compensator and its excitation settings (docs/compensation.md).
+    const EstimatorConfig& e = valve ? s.estimator : s.backlash_estimator;
+    j["adaptation"]["estimator"] = {{"model", to_string(e.model)},
+                                    {"lambda", e.rls.lambda},
+                                    {"forgetting", to_string(e.rls.forgetting)},
+                                    {"guess_right", e.guess_right},
+                                    {"guess_left", e.guess_left}};
+    if (!valve) j["adaptation"]["estimator"]["input_shift"] = s.backlash_estimator.input_shift;
     fmt::print("{}\n", j.dump());
     return kExitOk;
   }

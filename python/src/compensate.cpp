@@ -14,18 +14,14 @@ namespace {
 
 template <class Params>
 void check(const Params& p) {
-  try {
-    p.validate();
-  } catch (const std::invalid_argument& e) {
-    throw InputError("", 0, "", e.what());
-  }
+  checked("", [&] { p.validate(); });
 }
 
 /// Steps `block` through every sample of `u_obj` with the GIL released; the outputs as a new array.
 template <class Block>
 pyb::array_t<double> apply(Block& block, const pyb::handle& u_obj) {
-  const DoubleArray ua = as_doubles(u_obj, "u");
-  const auto u = span_of(ua);
+  const Doubles ua(u_obj, "u");
+  const auto u = ua.span();
   std::vector<double> out(u.size());
   {
     pyb::gil_scoped_release nogil;

@@ -80,6 +80,12 @@ DoubleArray as_doubles(const pyb::handle& obj, const char* name) {
   return a;
 }
 
+void Doubles::require_length_of(const Doubles& other) const {
+  if (size() != other.size())
+    throw InputError("", 0, name_,
+                     "has " + std::to_string(size()) + " samples, " + other.name_ + " has " + std::to_string(other.size()));
+}
+
 pyb::str text(const std::string& s) {
   PyObject* o = PyUnicode_DecodeUTF8(s.data(), static_cast<Py_ssize_t>(s.size()), nullptr);
   if (!o) {

@@ -24,16 +24,8 @@ namespace {
 EstimateSettings configure(const std::string& model, const std::string& preset, double dt_s,
                            const pyb::dict& settings, std::span<const double> v = {}, std::span<const double> y = {}) {
   SettingsSources src;
-  try {
-    src.model = parse_model_kind(model);
-  } catch (const std::invalid_argument& e) {
-    throw InputError("", 0, "model", e.what());
-  }
-  try {
-    src.preset = parse_preset(preset);
-  } catch (const std::invalid_argument& e) {
-    throw InputError("", 0, "preset", e.what());
-  }
+  src.model = checked("model", [&] { return parse_model_kind(model); });
+  src.preset = checked("preset", [&] { return parse_preset(preset); });
   const toml::table tbl = to_toml(settings);
   src.keys = &tbl;
   return resolve_settings(src, dt_s, v, y);
@@ -69,18 +61,11 @@ class Estimator {
   }
 
   pyb::array_t<double> update_many(const pyb::handle& v_obj, const pyb::handle& y_obj, const pyb::handle& t_obj) {
-    const DoubleArray va = as_doubles(v_obj, "v"), ya = as_doubles(y_obj, "y");
-    const auto v = span_of(va), y = span_of(ya);
-    if (v.size() != y.size())
-      throw InputError("", 0, "y", "has " + std::to_string(y.size()) + " samples, v has " + std::to_string(v.size()));
-    DoubleArray ta;
-    std::span<const double> t;
-    if (!t_obj.is_none()) {
-      ta = as_doubles(t_obj, "t");
-      t = span_of(ta);
-      if (t.size() != v.size())
-        throw InputError("", 0, "t", "has " + std::to_string(t.size()) + " samples, v has " + std::to_string(v.size()));
-    }
+    const Doubles va(v_obj, "v"), ya(y_obj, "y");
+    ya.require_length_of(va);
+    const Doubles ta = t_obj.is_none() ? Doubles() : Doubles(t_obj, "t");
+    if (!t_obj.is_none()) ta.require_length_of(va);
+    const auto v = va.span(), y = ya.span(), t = ta.span();
     std::vector<double> yhat(v.size());
     {
       pyb::gil_scoped_release nogil;
@@ -147,12 +132,10 @@ Result estimate(const pyb::handle& t_obj, const pyb::handle& v_obj, const pyb::h
                 const std::string& preset, double outlier_gate, bool trace, bool intervals,
                 const pyb::kwargs& settings) {
   configure(model, preset, 0.0, settings);  // settings are checked before the data is looked at
-  const DoubleArray ta = as_doubles(t_obj, "t"), va = as_doubles(v_obj, "v"), ya = as_doubles(y_obj, "y");
-  const auto t = span_of(ta), v = span_of(va), y = span_of(ya);
-  if (v.size() != t.size())
-    throw InputError("", 0, "v", "has " + std::to_string(v.size()) + " samples, t has " + std::to_string(t.size()));
-  if (y.size() != t.size())
-    throw InputError("", 0, "y", "has " + std::to_string(y.size()) + " samples, t has " + std::to_string(t.size()));
+  const Doubles ta(t_obj, "t"), va(v_obj, "v"), ya(y_obj, "y");
+  va.require_length_of(ta);
+  ya.require_length_of(ta);
+  const auto t = ta.span(), v = va.span(), y = ya.span();
   const double dt = sample_period(t, "", {}, "t");
   const EstimateSettings set = configure(model, preset, dt, settings, v, y);
   std::optional<AutoRun> ar;

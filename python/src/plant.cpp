@@ -13,15 +13,6 @@ namespace lash::py {
 
 namespace {
 
-template <class F>
-auto checked(const char* key, F&& f) {
-  try {
-    return f();
-  } catch (const std::invalid_argument& e) {
-    throw InputError("", 0, key, e.what());
-  }
-}
-
 struct PyPlant {
   Plant plant;
 
@@ -40,8 +31,8 @@ struct PyPlant {
   }
 
   pyb::dict simulate(const pyb::handle& v_obj, double noise_variance, std::uint64_t seed) {
-    const DoubleArray va = as_doubles(v_obj, "v");
-    const auto v = span_of(va);
+    const Doubles va(v_obj, "v");
+    const auto v = va.span();
     std::optional<SimulationTrace> tr;
     {
       pyb::gil_scoped_release nogil;

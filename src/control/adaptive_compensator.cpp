@@ -105,72 +105,39 @@ double ParameterGate::step(bool identified, double estimate) noexcept {
 Dither::Dither(double amplitude, double period_s, double dt_s) noexcept
     : amplitude_(amplitude), half_(std::max<std::uint64_t>(1, samples(0.5 * period_s, dt_s))) {}
 
-namespace {
-// The worse reason of two sides: adapting only if both adapt.
-AdaptationReason worse(AdaptationReason a, AdaptationReason b) noexcept {
-  return static_cast<std::uint8_t>(a) >= static_cast<std::uint8_t>(b) ? a : b;
-}
-AdaptationSettings checked(const AdaptationSettings& s) {
-  s.validate();
-  return s;
-}
-}  // namespace
-
-void DeadzoneCompensationConfig::validate() const {
-  nominal.validate();
-  adaptation.validate();
-  require(estimator.model == ModelKind::input_deadzone, "the deadzone compensator needs the input-deadzone estimator");
-  estimator.validate();
+void DeadzoneAdapter::validate(const EstimatorConfig& e) {
+  require(e.model == ModelKind::input_deadzone, "the deadzone compensator needs the input-deadzone estimator");
+  e.validate();
 }
 
-DeadzoneCompensator::DeadzoneCompensator(const DeadzoneCompensationConfig& c)
-    : cfg_((c.validate(), c)),
-      inv_(c.nominal),
-      est_(c.estimator),
-      gate_r_(c.nominal.offset_right, c.estimator.dt_s, checked(c.adaptation)),
-      gate_l_(c.nominal.offset_left, c.estimator.dt_s, c.adaptation),
-      dither_(c.adaptation.dither_amplitude, c.adaptation.dither_period_s, c.estimator.dt_s) {
+DeadzoneAdapter::DeadzoneAdapter(const CompensationConfig<DeadzoneAdapter>& c)
+    : est_(c.estimator),
+      ecfg_(c.estimator),
+      need_{c.adaptation.min_excitation_ratio * c.nominal.offset_right,
+            c.adaptation.min_excitation_ratio * c.nominal.offset_left} {
   exc_r_.lambda = exc_l_.lambda = c.estimator.rls.lambda;
 }
 
-void DeadzoneCompensator::observe(double v_applied, double y) noexcept {
-  if (cfg_.mode != CompensationMode::adaptive) return;
+PerSide<GateInput> DeadzoneAdapter::step(double v_applied, double y) noexcept {
   // The estimator's switching: v(k−1) beyond the guesses (the excitation record follows it).
   const double v1 = v1_;
   v1_ = v_applied;
   est_.step(v_applied, y);
-  if (v1 > cfg_.estimator.guess_right) exc_r_.add(v1);
-  else if (v1 < cfg_.estimator.guess_left) exc_l_.add(v1);
+  if (v1 > ecfg_.guess_right) exc_r_.add(v1);
+  else if (v1 < ecfg_.guess_left) exc_l_.add(v1);
   const SideParams r = est_.params(Side::right), l = est_.params(Side::left);
-  const double ratio = cfg_.adaptation.min_excitation_ratio;
-  const double need_r = ratio * cfg_.nominal.offset_right, need_l = ratio * cfg_.nominal.offset_left;
-  const bool ex_r = exc_r_.var >= need_r * need_r;  // std ≥ need, without a square root
-  const bool ex_l = exc_l_.var >= need_l * need_l;
-  const double old_r = gate_r_.value(), old_l = gate_l_.value();
-  const double cr = gate_r_.step(r.identified && ex_r, r.c);
-  const double cl = gate_l_.step(l.identified && ex_l, -l.c);
-  not_excited_r_ = r.identified && !ex_r;
-  not_excited_l_ = l.identified && !ex_l;
-  if (cr != old_r || cl != old_l) {
-    inv_.set_offsets(cr, cl);
-    ++updates_;
-  }
+  const bool ex_r = exc_r_.var >= need_.right * need_.right;  // std ≥ need, without a square root
+  const bool ex_l = exc_l_.var >= need_.left * need_.left;
+  not_excited_.right = r.identified && !ex_r;
+  not_excited_.left = l.identified && !ex_l;
+  return {{r.identified && ex_r, r.c}, {l.identified && ex_l, -l.c}};
 }
 
-AdaptationReason DeadzoneCompensator::reason() const noexcept {
-  auto side = [](const ParameterGate& g, bool not_excited) {
-    const AdaptationReason r = g.reason();
-    return (not_excited && r == AdaptationReason::not_identified) ? AdaptationReason::not_excited : r;
-  };
-  if (cfg_.mode != CompensationMode::adaptive) return AdaptationReason::nominal;
-  return worse(side(gate_r_, not_excited_r_), side(gate_l_, not_excited_l_));
-}
-
-const char* DeadzoneCompensator::estimator_reason(Side s) const noexcept {
-  if (cfg_.mode != CompensationMode::adaptive) return "no estimator (compensation is not adaptive)";
-  // The estimator's update-time verdict (identify/verdict.hpp, checks 1-5), then the compensator's own check.
-  switch (est_.params(s).reason) {
-    case Reason::none: break;
+namespace {
+// The estimator's update-time verdict (identify/verdict.hpp, checks 1-5) in words.
+const char* verdict_text(Reason r) noexcept {
+  switch (r) {
+    case Reason::none: return "identified";
     case Reason::not_updated: return "not_updated: too few samples beyond this side's guess (min_updates)";
     case Reason::not_excited: return "not_excited: v(k-1) or y(k-1) took a single value on this side's updates";
     case Reason::unstable: return "unstable: |a1| >= 1 or not finite";
@@ -178,61 +145,35 @@ const char* DeadzoneCompensator::estimator_reason(Side s) const noexcept {
     case Reason::poor_fit: return "poor_fit: the free run does not fit";
     case Reason::wrong_guess: return "wrong_guess: the edge lies outside this side's guess";
   }
-  if (s == Side::right ? not_excited_r_ : not_excited_l_)
+  return "?";
+}
+}  // namespace
+
+const char* DeadzoneAdapter::reason(Side s) const noexcept {
+  const Reason r = est_.params(s).reason;
+  if (r == Reason::none && not_excited_[s])
     return "identified by the estimator, but v hardly varied on this side (std below min_excitation_ratio x "
            "nominal): b1 and the offset are not separable; turn the dither on";
-  return "identified";
+  return verdict_text(r);
 }
 
-void GapEstimatorConfig::validate() const {
-  require(std::isfinite(dt_s) && dt_s > 0, "gap estimator dt_s must be > 0 [s]");
-  require(lambda > 0 && lambda <= 1, "gap estimator lambda must lie in (0, 1]");
-  require(std::isfinite(speed_min) && speed_min > 0, "gap estimator speed_min must be > 0");
-  require(run >= 1, "gap estimator run must be >= 1");
+void BacklashEstimatorConfig::validate() const {
+  require(model == ModelKind::deadzone_deadband, "the backlash compensator needs the deadzone-deadband estimator");
+  require(std::isfinite(input_shift) && input_shift > 0, "input_shift must be > 0 [position unit]");
+  require(guess_right > input_shift && guess_left < -input_shift,
+          "the estimator's guesses must lie beyond +-input_shift (guess_left < -s, guess_right > s)");
+  EstimatorConfig::validate();
 }
 
-GapEstimator::GapEstimator(const GapEstimatorConfig& c) : c_(c) {
-  c.validate();
-  up_.lambda = down_.lambda = c.lambda;
-}
-
-void BacklashCompensationConfig::validate() const {
-  nominal.validate();
-  adaptation.validate();
-  estimator.validate();
-}
-
-BacklashCompensator::BacklashCompensator(const BacklashCompensationConfig& c)
-    : cfg_((c.validate(), c)),
-      inv_(c.nominal),
-      est_(c.estimator),
-      gate_r_(c.nominal.right, c.estimator.dt_s, checked(c.adaptation)),
-      gate_l_(c.nominal.left, c.estimator.dt_s, c.adaptation),
-      dither_(c.adaptation.dither_amplitude, c.adaptation.dither_period_s, c.estimator.dt_s) {}
-
-void BacklashCompensator::observe(double w, double y) noexcept {
-  if (cfg_.mode != CompensationMode::adaptive) return;
-  est_.step(w, y);
-  const double old_r = gate_r_.value(), old_l = gate_l_.value();
-  const double r = gate_r_.step(est_.identified(Side::right), est_.gap(Side::right));
-  const double l = gate_l_.step(est_.identified(Side::left), est_.gap(Side::left));
-  if (r != old_r || l != old_l) {
-    inv_.set_params({r, l, cfg_.nominal.smoothing});
-    ++updates_;
-  }
-}
-
-AdaptationReason BacklashCompensator::reason() const noexcept {
-  if (cfg_.mode != CompensationMode::adaptive) return AdaptationReason::nominal;
-  return worse(gate_r_.reason(), gate_l_.reason());
-}
-
-const char* BacklashCompensator::estimator_reason() const noexcept {
-  if (cfg_.mode != CompensationMode::adaptive) return "no estimator (compensation is not adaptive)";
-  if (est_.identified()) return "identified";
-  if (est_.updates(Side::right) < cfg_.estimator.min_updates || est_.updates(Side::left) < cfg_.estimator.min_updates)
-    return "too few engaged samples in one direction (the carts must move together both ways)";
-  return "gap spread above 20 % of its mean (contact not steady)";
+const char* BacklashAdapter::reason(Side s) const noexcept {
+  const Reason r = est_.params(s).reason;
+  if (r == Reason::not_updated)
+    return "not_updated: too few samples moving each way beyond this side's guess (the carts must move "
+           "together both ways there: a reversing reference or a dither)";
+  if (r == Reason::unphysical)
+    return "unphysical: b1 <= 0, d < 0 or the edge on the wrong side of zero (input_shift below half the "
+           "difference of the gaps?)";
+  return verdict_text(r);
 }
 
 }  // namespace lash

@@ -108,24 +108,27 @@ void read_compensation(TomlTable& c, ClosedLoopScenario& s) {
     throw InputError(c.file(), c.line(), c.path(""), e.what());
   }
   if (!valve) {
-    GapEstimatorConfig& g = s.gap_estimator;
-    g.dt_s = s.dt_s;
-    g.lambda = c.number_or("gap_lambda", g.lambda);
-    g.speed_min = c.number_or("gap_speed_min", g.speed_min);
-    try {
-      g.validate();
-    } catch (const std::invalid_argument& e) {
-      throw InputError(c.file(), c.line(), c.path("gap_lambda"), e.what());
-    }
+    // The estimator's known input shift (BacklashEstimatorConfig); the guesses follow it.
+    BacklashEstimatorConfig& b = s.backlash_estimator;
+    b.input_shift = c.number_or("input_shift", b.input_shift);
+    if (!(b.input_shift > 0) || !std::isfinite(b.input_shift)) c.fail("input_shift", "must be > 0 [m]");
+    b.guess_right = 1.5 * b.input_shift;
+    b.guess_left = -1.5 * b.input_shift;
+  } else if (c.has("input_shift")) {
+    c.fail("input_shift", "belongs to the coupled_carts rig");
   }
   if (auto e = c.table_opt("estimator")) {
-    if (!valve) e->fail("", "the carts' gap estimator takes gap_lambda and gap_speed_min in [compensation]");
+    EstimatorConfig& ec = valve ? s.estimator : s.backlash_estimator;
     try {
-      read_estimator_config(*e, s.estimator);
+      read_estimator_config(*e, ec);
+      ec.dt_s = s.dt_s;
+      if (valve) ec.validate();
+      else s.backlash_estimator.validate();
     } catch (const std::invalid_argument& ex) {
       throw InputError(e->file(), e->line(), e->path(""), ex.what());
     }
   }
+  s.backlash_estimator.dt_s = s.dt_s;
   s.estimator.dt_s = s.dt_s;
   c.finish();
 }
@@ -144,6 +147,22 @@ EstimatorConfig default_estimator(const ClosedLoopScenario& s) {
     // drifted edge 380 mA is estimated as 368 mA by LS and 376 mA by IV).
     e.method = EstimationMethod::iv;
   }
+  return e;
+}
+
+// The carts' estimator (docs/compensation.md): deadzone-deadband on (w ± s, y), s = 2 × the rig's
+// half clearance, guesses ±1.5 s (updates where |w| > s/2), directional forgetting λ = 0.999:
+// the engaged carts excite only some directions of [a1, b1, e] (y − w is constant), and
+// exponential forgetting let the others wind up until the estimate left the physical range
+// after the clearance drift (measured: unphysical on both sides from 25 s on).
+BacklashEstimatorConfig default_backlash_estimator(const ClosedLoopScenario& s) {
+  BacklashEstimatorConfig e;
+  static_cast<EstimatorConfig&>(e) = EstimatorConfig::thesis(ModelKind::deadzone_deadband, s.dt_s);
+  e.input_shift = 2.0 * s.rig_config.coupled_carts.half_clearance_m;
+  e.guess_right = 1.5 * e.input_shift;
+  e.guess_left = -1.5 * e.input_shift;
+  e.rls.lambda = 0.999;
+  e.rls.forgetting = Forgetting::directional;
   return e;
 }
 
@@ -171,7 +190,7 @@ ClosedLoopScenario load_closed_loop_scenario(const std::filesystem::path& path) 
     s.rig_config = rigs::read_rig_config(s.rig, rp ? &*rp : nullptr);
   }
   s.estimator = default_estimator(s);
-  s.gap_estimator.dt_s = s.dt_s;
+  s.backlash_estimator = default_backlash_estimator(s);
   // Drifts: each key is checked by the rig reader itself (unknown keys, invalid values).
   rigs::RigConfig current = s.rig_config;
   double last_at = -1.0;
@@ -263,6 +282,19 @@ void record(ClosedLoopScenarioTrace& tr, double t, double r, double y, double cm
   tr.param_left.push_back(pl);
 }
 
+// The compensator's end state: the parameters in use, the updates and the verdict per side.
+template <class Comp>
+void finish(ClosedLoopScenarioResult& res, const Comp& comp) {
+  const PerSide<double> used = comp.in_use();
+  res.final_right = used.right;
+  res.final_left = used.left;
+  res.updates = comp.updates();
+  res.reason = comp.reason();
+  res.estimator_identified = comp.adapter().identified(Side::right) && comp.adapter().identified(Side::left);
+  res.estimator_reason = std::string("right: ") + comp.estimator_reason(Side::right) +
+                         "; left: " + comp.estimator_reason(Side::left);
+}
+
 }  // namespace
 
 ClosedLoopScenarioResult run_closed_loop_scenario(const ClosedLoopScenario& s, CompensationMode mode) {
@@ -295,25 +327,18 @@ ClosedLoopScenarioResult run_closed_loop_scenario(const ClosedLoopScenario& s, C
       const double u = pid.step(r - y) + s.feedforward * r;
       const double i = clamp(comp.command(u), s.command_min, s.command_max);
       comp.observe(i, y);
-      const bool on = mode != CompensationMode::none;
-      record(res.trace, t, r, p_true, i, on ? comp.inverse().params().offset_right : 0.0,
-             on ? -comp.inverse().params().offset_left : 0.0);
+      const PerSide<double> used = comp.in_use();
+      record(res.trace, t, r, p_true, i, used.right, used.left);
       score.add(t, r - p_true);
       y = rig.step(i);
       p_true = rig.true_pressure_kPa();
     }
-    res.final_right = mode == CompensationMode::none ? 0.0 : comp.inverse().params().offset_right;
-    res.final_left = mode == CompensationMode::none ? 0.0 : -comp.inverse().params().offset_left;
-    res.updates = comp.updates();
-    res.reason = comp.reason();
-    res.estimator_identified = comp.estimator().params(Side::right).identified && comp.estimator().params(Side::left).identified;
-    res.estimator_reason = std::string("right: ") + comp.estimator_reason(Side::right) +
-                           "; left: " + comp.estimator_reason(Side::left);
+    finish(res, comp);
   } else {
     BacklashCompensationConfig cc;
     cc.mode = mode;
     cc.nominal = s.backlash;
-    cc.estimator = s.gap_estimator;
+    cc.estimator = s.backlash_estimator;
     cc.adaptation = s.adaptation;
     BacklashCompensator comp(cc);
     rigs::CoupledCarts rig(s.rig_config.coupled_carts, dt, s.seed);
@@ -334,20 +359,15 @@ ClosedLoopScenarioResult run_closed_loop_scenario(const ClosedLoopScenario& s, C
       wstar1 = wstar;
       const double v = clamp(pid.step(wstar - w) + ff, s.command_min, s.command_max);
       comp.observe(w, y);
-      const bool on = mode != CompensationMode::none;
-      record(res.trace, t, r, y, v, on ? comp.inverse().params().right : 0.0, on ? comp.inverse().params().left : 0.0);
+      const PerSide<double> used = comp.in_use();
+      record(res.trace, t, r, y, v, used.right, used.left);
       res.trace.drive.push_back(w);
       score.add(t, r - y);
       rig.step(v);
       y = rig.free_position_m();
       w = rig.motor_position_m();
     }
-    res.final_right = mode == CompensationMode::none ? 0.0 : comp.inverse().params().right;
-    res.final_left = mode == CompensationMode::none ? 0.0 : comp.inverse().params().left;
-    res.updates = comp.updates();
-    res.reason = comp.reason();
-    res.estimator_identified = comp.estimator().identified();
-    res.estimator_reason = comp.estimator_reason();
+    finish(res, comp);
   }
   res.rms_error = score.n ? std::sqrt(score.sum2 / static_cast<double>(score.n)) : std::nan("");
   res.max_abs_error = score.max_abs;

@@ -26,6 +26,11 @@ check window_reversed   "window_reversed.toml:4: 'score_window_s'"              
 check nominal_sign      "nominal_sign.toml:[0-9]+: 'compensation.deadzone_left'.*<= 0"   "${head}${win}${tail}"$'[compensation]\ndeadzone_right = 288\ndeadzone_left = 296\n'
 check nominal_sign_r    "nominal_sign_r.toml:[0-9]+: 'compensation.deadzone_right'.*>= 0" "${head}${win}${tail}"$'[compensation]\ndeadzone_right = -288\n'
 check carts_sign        "carts_sign.toml:[0-9]+: 'compensation.deadband_left'.*>= 0" $'rig = "coupled_carts"\ndt_s = 0.001\nduration_s = 2\n'"${win}${tail}"$'[compensation]\ndeadband_left = -0.005\n'
+carts=$'rig = "coupled_carts"\ndt_s = 0.001\nduration_s = 2\n'"${win}${tail}"
+check carts_shift       "carts_shift.toml:[0-9]+: 'compensation.input_shift'.*> 0"      "${carts}"$'[compensation]\ninput_shift = -0.01\n'
+check carts_guess       "carts_guess.toml:[0-9]+: 'compensation.estimator'.*input_shift" "${carts}"$'[compensation]\n[compensation.estimator]\nguess_right = 0.005\n'
+check carts_model       "carts_model.toml:[0-9]+: 'compensation.estimator'.*deadzone-deadband" "${carts}"$'[compensation]\n[compensation.estimator]\nmodel = "coupled-carts"\n'
+check valve_shift       "valve_shift.toml:[0-9]+: 'compensation.input_shift'.*coupled_carts" "${head}${win}${tail}"$'[compensation]\ninput_shift = 0.01\n'
 check wrong_rig_key     "wrong_rig_key.toml:[0-9]+: 'compensation.deadband_right'"         "${head}${win}${tail}"$'[compensation]\ndeadband_right = 0.005\n'
 out=$("$LASH" closed-loop --scenario "$d/nope.toml" 2>&1); rc=$?
 [[ $rc -eq 2 && $out == *"nope.toml"* ]] || { echo "FAIL missing file: $rc $out"; fail=1; }

@@ -3,7 +3,8 @@
 this test, on the scenarios shipped in config/scenarios/closed_loop/:
  - valve, deadzone 288 -> 380 mA at 20 s, sine reference: over the window after the drift
    adaptive RMS error <= 0.5 x fixed and <= 0.3 x none;
- - coupled carts, clearance 5 -> 8 mm per side at 20 s: adaptive <= 0.5 x none and <= 0.7 x fixed;
+ - coupled carts, clearance 5 -> 8 mm per side at 20 s: adaptive <= 0.5 x none and <= 0.7 x fixed,
+   with lash's deadzone-deadband estimator inside the compensator;
  - no drift, exact nominal parameters (valve and carts): adaptive <= 1.1 x fixed;
  - constant set point for the whole run: adaptive makes no change without dither (and the
    verdict says why), and does adapt with its dither on;
@@ -59,6 +60,11 @@ check(e["adaptive"] <= 0.7 * e["fixed"], "carts drift: adaptive <= 0.7 x fixed")
 fin = r["adaptive"]["compensation"]["final"]
 check(abs(fin["right"] - 0.008) < 0.001 and abs(fin["left"] - 0.008) < 0.001,
       f"carts drift: adapted half-widths {fin} within 1 mm of 8 mm")
+a = r["adaptive"]["adaptation"]
+check(a["estimator"]["model"] == "deadzone-deadband" and a["estimator_identified"],
+      f"carts drift: lash's deadzone-deadband estimator identified both sides ({a['estimator_reason']})")
+check(a["dither_amplitude"] == 0 and a["estimator"]["input_shift"] > 0,
+      f"carts drift: excitation reported (dither {a['dither_amplitude']} m, input shift {a['estimator']['input_shift']} m)")
 
 for name in ("valve_no_drift", "carts_no_drift"):
     r, e = trio(name)

@@ -3,6 +3,8 @@
 // random signals (exactly outside the smoothing band, within it up to the band), per side.
 #include <gtest/gtest.h>
 
+#include "ref_backlash.hpp"
+
 #include <cmath>
 #include <stdexcept>
 
@@ -20,16 +22,7 @@ double sloped_deadzone(const Deadzone& dz, double mr, double ml, double v) {
   return out > 0 ? mr * out : ml * out;
 }
 
-// Reference backlash with a gap per direction (Tao & Kokotović's characteristic), written
-// independently of lash's Deadband so the asymmetric case has a check too.
-struct RefBacklash {
-  double cr, cl, y;
-  double step(double w) {
-    if (w > y + cr) y = w - cr;
-    else if (w < y - cl) y = w + cl;
-    return y;
-  }
-};
+using test::RefBacklash;  // the asymmetric case's oracle (ref_backlash.hpp)
 }  // namespace
 
 TEST(DeadzoneInverse, ThesisHandValues) {

@@ -124,124 +124,63 @@ struct Excitation {
 };
 }  // namespace detail
 
-/// Input deadzone (pilot valve): InputDeadzoneEstimator → per-side gates → DeadzoneInverse.
-struct DeadzoneCompensationConfig {
+/// Estimate of one inverse parameter as an adapter hands it to its gate: `ok` is the verdict
+/// for that parameter (identified, and the adapter's own checks), `value` its estimate.
+struct GateInput {
+  bool ok = false;
+  double value = 0.0;
+};
+
+/// Configuration of a Compensator: the mode, the nominal inverse, the estimator's settings and
+/// the safeguards. Adapter::Params are the inverse's parameters, Adapter::EstimatorSettings the
+/// estimator's.
+template <class Adapter>
+struct CompensationConfig {
   CompensationMode mode = CompensationMode::fixed;
-  DeadzoneInverseParams nominal;  ///< the fixed inverse; the start of the adaptive one
-  EstimatorConfig estimator;      ///< model must be input_deadzone; dt_s is the loop's
+  typename Adapter::Params nominal;              ///< the fixed inverse; the start of the adaptive one
+  typename Adapter::EstimatorSettings estimator;  ///< dt_s is the loop's
   AdaptationSettings adaptation;
   /// Throws std::invalid_argument naming the field.
-  void validate() const;
-};
-
-class DeadzoneCompensator {
- public:
-  /// Throws std::invalid_argument (see DeadzoneCompensationConfig::validate).
-  explicit DeadzoneCompensator(const DeadzoneCompensationConfig& c);
-  /// Desired deadzone output u(k) → command v(k) (dither added to u first, adaptive only).
-  double command(double u) noexcept {
-    switch (cfg_.mode) {
-      case CompensationMode::none: return u;
-      case CompensationMode::fixed: return inv_.step(u);
-      case CompensationMode::adaptive: break;
-    }
-    return inv_.step(u + dither_.step());
+  void validate() const {
+    nominal.validate();
+    adaptation.validate();
+    Adapter::validate(estimator);
   }
-  /// After the command was applied: the sample (v(k) as applied, y(k) measured before it).
-  /// Adaptive mode steps the estimator and moves the inverse's edges through the gates.
-  void observe(double v_applied, double y) noexcept;
-
-  const DeadzoneInverse& inverse() const noexcept { return inv_; }
-  const InputDeadzoneEstimator& estimator() const noexcept { return est_; }
-  const ParameterGate& gate(Side s) const noexcept { return s == Side::right ? gate_r_ : gate_l_; }
-  /// Samples on which the inverse's parameters changed.
-  std::uint64_t updates() const noexcept { return updates_; }
-  /// The worse of the two sides' reasons (adapting only when both adapt).
-  AdaptationReason reason() const noexcept;
-  /// Why a side is not used: the estimator's verdict reason (identify/verdict.hpp) or the
-  /// compensator's excitation check (a fixed text, no allocation).
-  const char* estimator_reason(Side s) const noexcept;
-  const DeadzoneCompensationConfig& config() const noexcept { return cfg_; }
-
- private:
-  DeadzoneCompensationConfig cfg_;
-  DeadzoneInverse inv_;
-  InputDeadzoneEstimator est_;
-  ParameterGate gate_r_, gate_l_;
-  Dither dither_;
-  detail::Excitation exc_r_, exc_l_;
-  double v1_ = 0.0;
-  bool not_excited_r_ = false, not_excited_l_ = false;
-  std::uint64_t updates_ = 0;
 };
 
-/// Online estimate of a backlash's gaps from the driving position w and the driven position y
-/// (coupled carts: motor cart and free cart). While the two move together (engaged: both
-/// velocities agree within 10 % and exceed `speed_min` for `run` samples), w − y is the gap of
-/// that direction: +c_r moving up, −c_l' moving down (the backlash of backlash_inverse.hpp).
-/// Each direction keeps an exponentially weighted mean and spread with forgetting λ; a
-/// direction is identified after `min_updates` engaged samples with spread ≤ 20 % of the mean
-/// and a positive mean. step() is noexcept and O(1).
-struct GapEstimatorConfig {
-  double dt_s = 0.001;         ///< sample period [s]
-  double lambda = 0.999;       ///< forgetting factor per engaged sample [-]
-  double speed_min = 0.005;    ///< engaged only above this speed [position unit/s]
-  std::uint32_t run = 3;       ///< engaged samples in a row before the gap counts [-]
-  std::uint64_t min_updates = 200;  ///< engaged samples per direction before identified [-]
-  void validate() const;
-};
-
-class GapEstimator {
+/// The adaptive compensator, one template for every inverse: the command path (none / fixed /
+/// adaptive with the square-wave dither) and the gate wiring (one ParameterGate per side between
+/// the estimate and the inverse) are shared; the Adapter owns the estimator and says how its
+/// estimates map to the inverse's two parameters. An Adapter provides:
+///   - types Params (the inverse's), EstimatorSettings, Estimator;
+///   - static validate(const EstimatorSettings&) (throws std::invalid_argument);
+///   - static nominal(const Params&) -> PerSide<double>, the gates' nominal values;
+///   - static apply(Inverse&, double right, double left, const Params& nominal) noexcept;
+///   - static in_use(const Inverse&) -> PerSide<double>, the parameters as reported;
+///   - Adapter(const CompensationConfig<Adapter>&);
+///   - step(double a, double b) noexcept -> PerSide<GateInput>, one sample of the estimator;
+///   - refine(Side, AdaptationReason) noexcept, the adapter's own refusal (e.g. not_excited);
+///   - reason(Side) noexcept -> const char*, why a side is (not) used;
+///   - identified(Side) noexcept, the estimator's own verdict on a side;
+///   - estimator() -> const Estimator&.
+/// command() and observe() are noexcept, O(1) and allocation-free.
+template <class Inverse, class Adapter>
+class Compensator {
  public:
-  explicit GapEstimator(const GapEstimatorConfig& c);
-  void step(double w, double y) noexcept {
-    const double wd = (w - w1_) / c_.dt_s, yd = (y - y1_) / c_.dt_s;
-    w1_ = w;
-    y1_ = y;
-    const int dir = yd > c_.speed_min ? 1 : (yd < -c_.speed_min ? -1 : 0);
-    const bool together = dir != 0 && std::fabs(wd - yd) <= 0.1 * std::fabs(yd);
-    run_ = (together && dir == dir1_) ? run_ + 1 : (together ? 1 : 0);
-    dir1_ = dir;
-    if (!first_ && run_ >= c_.run) {
-      auto& g = dir > 0 ? up_ : down_;
-      g.add(dir > 0 ? w - y : y - w);
-      ++n_[dir > 0 ? 0 : 1];
-    }
-    first_ = false;
-  }
-  /// Gap of one side (right = pushing up, c_r; left = pushing down, c_l') [position unit].
-  double gap(Side s) const noexcept { return (s == Side::right ? up_ : down_).mean; }
-  std::uint64_t updates(Side s) const noexcept { return n_[s == Side::right ? 0 : 1]; }
-  bool identified(Side s) const noexcept {
-    const auto& g = s == Side::right ? up_ : down_;
-    return updates(s) >= c_.min_updates && g.mean > 0.0 && g.stddev() <= 0.2 * g.mean;
-  }
-  bool identified() const noexcept { return identified(Side::right) && identified(Side::left); }
+  using Config = CompensationConfig<Adapter>;
+  using Estimator = typename Adapter::Estimator;
 
- private:
-  GapEstimatorConfig c_;
-  detail::Excitation up_, down_;
-  std::uint64_t n_[2] = {0, 0};
-  double w1_ = 0.0, y1_ = 0.0;
-  int dir1_ = 0;
-  std::uint32_t run_ = 0;
-  bool first_ = true;
-};
+  /// Throws std::invalid_argument (see CompensationConfig::validate).
+  explicit Compensator(const Config& c)
+      : cfg_((c.validate(), c)),
+        inv_(c.nominal),
+        adapter_(c),
+        gate_r_(Adapter::nominal(c.nominal).right, c.estimator.dt_s, c.adaptation),
+        gate_l_(Adapter::nominal(c.nominal).left, c.estimator.dt_s, c.adaptation),
+        dither_(c.adaptation.dither_amplitude, c.adaptation.dither_period_s, c.estimator.dt_s) {}
 
-/// Backlash between a driving and a driven position (coupled carts): GapEstimator on
-/// (w, y) → one gate per side → BacklashInverse.
-struct BacklashCompensationConfig {
-  CompensationMode mode = CompensationMode::fixed;
-  BacklashInverseParams nominal;  ///< the fixed inverse; the start of the adaptive one
-  GapEstimatorConfig estimator;
-  AdaptationSettings adaptation;
-  void validate() const;
-};
-
-class BacklashCompensator {
- public:
-  explicit BacklashCompensator(const BacklashCompensationConfig& c);
-  /// Desired driven position u(k) → driving position w(k).
+  /// Desired output u(k) of the nonlinearity → its input (the command; dither added to u first,
+  /// adaptive only).
   double command(double u) noexcept {
     switch (cfg_.mode) {
       case CompensationMode::none: return u;
@@ -251,25 +190,157 @@ class BacklashCompensator {
     return inv_.step(u + dither_.step());
   }
   /// Starts the inverse at rest at u0 (engaged pushing up), as BacklashInverse::reset.
-  void reset(double u0) noexcept { inv_.reset(u0, true); }
-  /// Each sample: the driving position w(k) and the driven position y(k) as measured.
-  void observe(double w, double y) noexcept;
+  void reset(double u0) noexcept
+    requires requires(Inverse& i) { i.reset(u0, true); }
+  {
+    inv_.reset(u0, true);
+  }
+  /// After the command was applied: one sample (a, b) of the estimator (the adapter's meaning:
+  /// valve (v(k) as applied, y(k) measured before it); carts (drive, driven position)).
+  /// Adaptive mode steps the estimator and moves the inverse's parameters through the gates.
+  void observe(double a, double b) noexcept {
+    if (cfg_.mode != CompensationMode::adaptive) return;
+    const PerSide<GateInput> e = adapter_.step(a, b);
+    const double old_r = gate_r_.value(), old_l = gate_l_.value();
+    const double r = gate_r_.step(e.right.ok, e.right.value);
+    const double l = gate_l_.step(e.left.ok, e.left.value);
+    if (r != old_r || l != old_l) {
+      Adapter::apply(inv_, r, l, cfg_.nominal);
+      ++updates_;
+    }
+  }
 
-  const BacklashInverse& inverse() const noexcept { return inv_; }
-  const GapEstimator& estimator() const noexcept { return est_; }
+  const Inverse& inverse() const noexcept { return inv_; }
+  const Estimator& estimator() const noexcept { return adapter_.estimator(); }
+  const Adapter& adapter() const noexcept { return adapter_; }
   const ParameterGate& gate(Side s) const noexcept { return s == Side::right ? gate_r_ : gate_l_; }
+  /// The inverse's two parameters as in use (0 without an inverse, mode none).
+  PerSide<double> in_use() const noexcept {
+    return cfg_.mode == CompensationMode::none ? PerSide<double>{} : Adapter::in_use(inv_);
+  }
+  /// Samples on which the inverse's parameters changed.
   std::uint64_t updates() const noexcept { return updates_; }
-  AdaptationReason reason() const noexcept;
-  const char* estimator_reason() const noexcept;
-  const BacklashCompensationConfig& config() const noexcept { return cfg_; }
+  /// The worse of the two sides' reasons (adapting only when both adapt).
+  AdaptationReason reason() const noexcept {
+    if (cfg_.mode != CompensationMode::adaptive) return AdaptationReason::nominal;
+    const AdaptationReason r = adapter_.refine(Side::right, gate_r_.reason());
+    const AdaptationReason l = adapter_.refine(Side::left, gate_l_.reason());
+    return static_cast<std::uint8_t>(r) >= static_cast<std::uint8_t>(l) ? r : l;
+  }
+  /// Why a side is not used: the estimator's verdict or the adapter's own check (a fixed text,
+  /// no allocation).
+  const char* estimator_reason(Side s) const noexcept {
+    if (cfg_.mode != CompensationMode::adaptive) return "no estimator (compensation is not adaptive)";
+    return adapter_.reason(s);
+  }
+  const Config& config() const noexcept { return cfg_; }
 
  private:
-  BacklashCompensationConfig cfg_;
-  BacklashInverse inv_;
-  GapEstimator est_;
+  Config cfg_;
+  Inverse inv_;
+  Adapter adapter_;
   ParameterGate gate_r_, gate_l_;
   Dither dither_;
   std::uint64_t updates_ = 0;
 };
+
+/// Input deadzone (pilot valve): InputDeadzoneEstimator on (v(k) as applied, y(k)) → the edges
+/// c_r, c_l, used while the side is identified and the command varied enough on that side
+/// (min_excitation_ratio).
+class DeadzoneAdapter {
+ public:
+  using Params = DeadzoneInverseParams;
+  using EstimatorSettings = EstimatorConfig;
+  using Estimator = InputDeadzoneEstimator;
+  /// The model must be input_deadzone.
+  static void validate(const EstimatorConfig& e);
+  static PerSide<double> nominal(const Params& p) noexcept { return {p.offset_right, p.offset_left}; }
+  static void apply(DeadzoneInverse& inv, double right, double left, const Params&) noexcept {
+    inv.set_offsets(right, left);
+  }
+  /// Edges as the deadzone has them: c_r ≥ 0 ≥ c_l [mA].
+  static PerSide<double> in_use(const DeadzoneInverse& inv) noexcept {
+    return {inv.params().offset_right, -inv.params().offset_left};
+  }
+  explicit DeadzoneAdapter(const CompensationConfig<DeadzoneAdapter>& c);
+  PerSide<GateInput> step(double v_applied, double y) noexcept;
+  AdaptationReason refine(Side s, AdaptationReason r) const noexcept {
+    return (not_excited_[s] && r == AdaptationReason::not_identified) ? AdaptationReason::not_excited : r;
+  }
+  const char* reason(Side s) const noexcept;
+  /// The estimator's own verdict on side s (update-time checks 1–5).
+  bool identified(Side s) const noexcept { return est_.params(s).identified; }
+  const Estimator& estimator() const noexcept { return est_; }
+
+ private:
+  InputDeadzoneEstimator est_;
+  EstimatorConfig ecfg_;
+  PerSide<double> need_;  // min_excitation_ratio × nominal per side
+  detail::Excitation exc_r_, exc_l_;
+  double v1_ = 0.0;
+  PerSide<bool> not_excited_{};
+};
+
+/// Settings of the carts' estimator: lash's deadzone-deadband estimator (identify/estimators.hpp)
+/// and the known input shift s that puts its deadzone edge on its own side of zero.
+struct BacklashEstimatorConfig : EstimatorConfig {
+  /// s [position unit]: the estimator sees v = w + s for w ≥ 0 and w − s for w < 0, i.e. a
+  /// deadzone of known edges ±s in front of the backlash. The carts have no input deadzone
+  /// (c = 0 ± noise would fail the verdict's c_r ≥ 0 ≥ c_l half the time); with the shift the
+  /// edges are ±s + (c_r − c_l')/2 and the gaps follow as d ± (c − (±s)). Needs
+  /// s > |c_r − c_l'|/2 and the guesses beyond s + that.
+  double input_shift = 0.01;
+  /// Throws std::invalid_argument naming the field.
+  void validate() const;
+};
+
+/// Backlash between a driving and a driven position (coupled carts, the backlash of
+/// backlash_inverse.hpp: y = w − c_r pushing up, y = w + c_l' pushing down): lash's
+/// DeadzoneDeadbandEstimator (§1.4.3) on v = w ± s and y, the driven position one sample
+/// earlier (so that y(k−1) is regressed on w(k−1): the engaged carts are rigid). Side right
+/// (w > guess_right − s) gives (c_R, d_R), side left (c_L, d_L); the gaps handed to the gates are
+///   c_r = d_R + (c_R − s)   (identified while the right side is),
+///   c_l' = d_L − (c_L + s)  (identified while the left side is).
+/// While engaged y(k−1) − w(k−1) is constant, so a1 and b1 are not determined separately
+/// (only b1 = 1 + a1); (c, d) are (eq. 31/32 are invariant along that direction). The full
+/// verdict's conditioning check (verdict(), check 2) would say so; the gates use the update-time
+/// verdict params(s).identified (checks 1–5), as the valve's.
+class BacklashAdapter {
+ public:
+  using Params = BacklashInverseParams;
+  using EstimatorSettings = BacklashEstimatorConfig;
+  using Estimator = DeadzoneDeadbandEstimator;
+  /// The model must be deadzone_deadband, input_shift > 0 and the guesses beyond ±input_shift.
+  static void validate(const BacklashEstimatorConfig& e) { e.validate(); }
+  static PerSide<double> nominal(const Params& p) noexcept { return {p.right, p.left}; }
+  static void apply(BacklashInverse& inv, double right, double left, const Params& nominal) noexcept {
+    inv.set_params({right, left, nominal.smoothing});
+  }
+  static PerSide<double> in_use(const BacklashInverse& inv) noexcept { return {inv.params().right, inv.params().left}; }
+  explicit BacklashAdapter(const CompensationConfig<BacklashAdapter>& c) : est_(c.estimator), s_(c.estimator.input_shift) {}
+  /// w: driving position, y: driven position, both measured at k.
+  PerSide<GateInput> step(double w, double y) noexcept {
+    est_.step(w >= 0.0 ? w + s_ : w - s_, y1_);
+    y1_ = y;
+    const SideParams r = est_.params(Side::right), l = est_.params(Side::left);
+    return {{r.identified, r.d + (r.c - s_)}, {l.identified, l.d - (l.c + s_)}};
+  }
+  AdaptationReason refine(Side, AdaptationReason r) const noexcept { return r; }
+  const char* reason(Side s) const noexcept;
+  bool identified(Side s) const noexcept { return est_.params(s).identified; }
+  const Estimator& estimator() const noexcept { return est_; }
+
+ private:
+  DeadzoneDeadbandEstimator est_;
+  double s_;
+  double y1_ = 0.0;
+};
+
+/// The valve's compensator (names kept: DeadzoneCompensationConfig, DeadzoneCompensator).
+using DeadzoneCompensationConfig = CompensationConfig<DeadzoneAdapter>;
+using DeadzoneCompensator = Compensator<DeadzoneInverse, DeadzoneAdapter>;
+/// The carts' compensator.
+using BacklashCompensationConfig = CompensationConfig<BacklashAdapter>;
+using BacklashCompensator = Compensator<BacklashInverse, BacklashAdapter>;
 
 }  // namespace lash

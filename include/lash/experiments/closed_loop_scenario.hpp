@@ -54,7 +54,7 @@ struct ClosedLoopScenario {
   DeadzoneInverseParams deadzone;    ///< valve
   BacklashInverseParams backlash;    ///< carts
   EstimatorConfig estimator;         ///< valve: the adaptive compensator's input-deadzone estimator
-  GapEstimatorConfig gap_estimator;  ///< carts: the adaptive compensator's gap estimator
+  BacklashEstimatorConfig backlash_estimator;  ///< carts: the adaptive compensator's deadzone-deadband estimator
   AdaptationSettings adaptation;
   double score_t0_s = 0.0, score_t1_s = 0.0;  ///< score window [s]
 };
