@@ -38,9 +38,7 @@ const Data& e1_data() {
 }
 
 lash::EstimatorConfig thesis(lash::ModelKind m) {
-  lash::EstimatorConfig c;
-  c.model = m;
-  c.dt_s = 0.005;
+  lash::EstimatorConfig c = lash::EstimatorConfig::thesis(m, 0.005);
   c.guess_left = -350;
   c.guess_right = 350;
   return c;

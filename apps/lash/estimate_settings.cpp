@@ -1,12 +1,15 @@
 #include "estimate_settings.hpp"
 
-#include <cmath>
 #include <stdexcept>
+#include <type_traits>
+#include <variant>
 
-#include "cli_common.hpp"
-#include "lash/io/toml_util.hpp"
+#include "lash/identify/config_fields.hpp"
+#include "lash/io/error.hpp"
 
 namespace lash::cli {
+
+namespace {
 
 std::vector<std::string> split_names(const std::string& text) {
   std::vector<std::string> out;
@@ -23,78 +26,65 @@ std::vector<std::string> split_names(const std::string& text) {
   return out;
 }
 
-/// preset → data-dependent settings (lash preset, when the record is known) → --config → options.
-EstimatorConfig assemble(const EstimateOptions& o, ModelKind model, Preset preset, const Record* rec,
-                         EstimationJob& job) {
-  if (!o.config.empty() && !o.preset_given) {  // a `preset` key in the file applies unless --preset is given
-    const toml::table root = parse_toml_file(o.config);
-    TomlTable t(root, o.config);
-    if (auto p = t.string_opt("preset")) {
-      try {
-        preset = parse_preset(*p);
-      } catch (const std::invalid_argument& e) {
-        t.fail("preset", e.what());
-      }
-    }
+/// How --help shows the value of a field.
+const char* type_name(const ConfigField::Ref& r) {
+  return std::visit(
+      [](auto* p) -> const char* {
+        using T = std::remove_pointer_t<decltype(p)>;
+        if constexpr (std::is_same_v<T, double>) return "NUMBER";
+        else if constexpr (std::is_same_v<T, std::size_t> || std::is_same_v<T, std::uint32_t>) return "INT";
+        else if constexpr (std::is_same_v<T, std::array<double, 3>>) return "A1,B1,E";
+        else return "NAME";
+      },
+      r);
+}
+
+}  // namespace
+
+void add_setting_options(CLI::App& sub, EstimateOptions& o) {
+  EstimatorConfig probe;
+  for (const ConfigField& f : estimator_fields()) {
+    if (*f.flag == '\0') continue;
+    const std::string name = std::string("--") + f.flag;
+    const auto ref = f.at(probe);
+    if (std::holds_alternative<bool*>(ref))
+      sub.add_flag(name, o.switches[f.flag], f.doc);
+    else
+      sub.add_option(name, o.texts[f.flag], f.doc)->type_name(type_name(ref));
   }
-  EstimatorConfig cfg = preset_config(model, preset);
-  if (rec) {
-    cfg.dt_s = rec->dt_s;
-    if (preset == Preset::lash) tune_to_data(cfg, analyse_record(rec->v(), rec->y(), rec->dt_s));
-  }
-  if (!o.config.empty()) {
-    const toml::table root = parse_toml_file(o.config);
-    TomlTable t(root, o.config);
-    (void)t.string_opt("preset");
-    read_estimator_config(t, cfg, &job);
-  }
-  cfg.model = model;
-  if (o.guess_left) cfg.guess_left = *o.guess_left;
-  if (o.guess_right) cfg.guess_right = *o.guess_right;
-  if (o.lambda) cfg.rls.lambda = *o.lambda;
-  if (o.p0) cfg.rls.p0 = *o.p0;
-  if (o.filter_length) cfg.noise.filter_length = *o.filter_length;
-  if (o.filter_input) cfg.noise.filter_input = true;
-  if (o.derivative_filter_length) cfg.noise.derivative_filter_length = *o.derivative_filter_length;
-  if (o.derivative_prefilter_length) cfg.noise.derivative_prefilter_length = *o.derivative_prefilter_length;
-  if (o.derivative_threshold) cfg.noise.derivative_threshold = *o.derivative_threshold;
-  if (o.input_delay) cfg.noise.input_delay = *o.input_delay;
-  if (o.align_delay) cfg.noise.align_delay = *o.align_delay;
-  if (o.direction_run) cfg.direction_run = static_cast<std::uint32_t>(*o.direction_run);
-  if (o.min_updates) cfg.min_updates = *o.min_updates;
-  if (o.iv_delay) cfg.iv_delay = *o.iv_delay;
-  if (o.pooled) cfg.pooled = true;
-  if (o.accel_limit) cfg.accel_limit = *o.accel_limit;
-  if (o.stage2_start) cfg.stage2_start_s = *o.stage2_start;
-  if (o.zero_threshold) cfg.zero_threshold = *o.zero_threshold;
-  if (o.method) {
+}
+
+SettingsSources settings_sources(const CLI::App& sub, const EstimateOptions& o) {
+  SettingsSources s;
+  if (!o.model.empty()) {
     try {
-      cfg.method = parse_method(*o.method);
+      s.model = parse_model_kind(o.model);
     } catch (const std::invalid_argument& e) {
-      throw InputError("", 0, "--method", e.what());
+      throw InputError("", 0, "--model", e.what());
     }
   }
-  if (o.forgetting) {
+  if (sub.get_option("--preset")->count() > 0) {  // else a `preset` key in --config, else lash
     try {
-      cfg.rls.forgetting = parse_forgetting(*o.forgetting);
+      s.preset = parse_preset(o.preset);
     } catch (const std::invalid_argument& e) {
-      throw InputError("", 0, "--forgetting", e.what());
+      throw InputError("", 0, "--preset", e.what());
     }
   }
-  if (!o.columns.empty()) job.columns = split_names(o.columns);
+  s.config_file = o.config;
+  for (const ConfigField& f : estimator_fields()) {
+    if (*f.flag == '\0' || sub.get_option(std::string("--") + f.flag)->count() == 0) continue;
+    if (const auto sw = o.switches.find(f.flag); sw != o.switches.end())
+      s.options.emplace_back(f.flag, sw->second ? "true" : "false");
+    else
+      s.options.emplace_back(f.flag, o.texts.at(f.flag));
+  }
+  if (!o.columns.empty()) s.columns = split_names(o.columns);
   if (!o.nrmse_window.empty()) {
-    if (o.nrmse_window.size() != 2 || !(o.nrmse_window[0] >= 0) || !(o.nrmse_window[0] < o.nrmse_window[1]) ||
-        !std::isfinite(o.nrmse_window[1]))
+    if (o.nrmse_window.size() != 2)
       throw InputError("", 0, "--nrmse-window", "expected T0 T1 with 0 <= T0 < T1, finite [s]");
-    job.nrmse_t0_s = o.nrmse_window[0];
-    job.nrmse_t1_s = o.nrmse_window[1];
+    s.nrmse_window_s = std::pair{o.nrmse_window[0], o.nrmse_window[1]};
   }
-  try {
-    cfg.validate();
-  } catch (const std::invalid_argument& e) {
-    throw InputError(o.config, 0, "", e.what());
-  }
-  return cfg;
+  return s;
 }
 
 }  // namespace lash::cli

@@ -1,13 +1,15 @@
 #pragma once
-// `lash estimate`'s options and how they become an EstimatorConfig: the preset, the settings
-// chosen from the record (lash preset), then --config, then the command-line options.
+// `lash estimate`'s options. The estimator settings are registered from the library's field table
+// (lash/identify/config_fields.hpp) and handed, as given, to lash::resolve_settings
+// (lash/identify/config_sources.hpp), the same path Python's lash.estimate takes.
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "lash/identify/auto.hpp"
-#include "lash/identify/config_file.hpp"
-#include "lash/identify/data.hpp"
+#include <CLI/CLI.hpp>
+
+#include "lash/identify/config_sources.hpp"
 
 namespace lash::cli {
 
@@ -15,12 +17,8 @@ struct EstimateOptions {
   std::string data;
   std::string model;
   std::string config;
-  std::optional<double> guess_left, guess_right, lambda, p0, derivative_threshold;
-  std::optional<std::size_t> filter_length, derivative_filter_length, derivative_prefilter_length, input_delay,
-      align_delay, direction_run, min_updates, iv_delay;
-  std::optional<std::string> method, forgetting;
-  bool filter_input = false, pooled = false;
-  std::optional<double> accel_limit, stage2_start, zero_threshold;
+  std::map<std::string, std::string> texts;  // field-table options with a value, by flag
+  std::map<std::string, bool> switches;      // field-table options without a value (--pooled), by flag
   std::string columns;
   std::vector<double> nrmse_window;
   std::string out;
@@ -29,17 +27,15 @@ struct EstimateOptions {
   bool strict = false;  ///< a non-finite row is an error instead of skipped
   bool timing = false;
   std::string preset = "lash";
-  bool preset_given = false;  // --preset on the command line (beats a `preset` key in --config)
   bool print_config = false;
   double outlier_gate = 12.0;
-  std::vector<std::string> given;  // options given on the command line (without dashes)
 };
 
-std::vector<std::string> split_names(const std::string& text);
+/// Registers one option per field of the table that has a flag (`--lambda`, `--pooled`, …).
+void add_setting_options(CLI::App& sub, EstimateOptions& o);
 
-/// preset → settings chosen from `rec` (lash preset; none when rec is null) → --config → options.
-/// Validated; throws InputError naming the option or file.
-EstimatorConfig assemble(const EstimateOptions& o, ModelKind model, Preset preset, const Record* rec,
-                         EstimationJob& job);
+/// What the command line says about the settings (options given, in the table's order).
+/// Throws InputError naming the option.
+SettingsSources settings_sources(const CLI::App& sub, const EstimateOptions& o);
 
 }  // namespace lash::cli

@@ -30,10 +30,11 @@ int main(int argc, char** argv) try {
   sim.seed = 1;
   const SimulationTrace rec = simulate(plant, sim);
 
-  // 2. The estimator: lash's settings for the model, the ones that depend on the record
+  // 2. The estimator: lash's settings for the model (a default-constructed config holds them;
+  //    EstimatorConfig::thesis(model) gives the thesis's), the ones that depend on the record
   //    (noise level, output rate) chosen from it, and no switching guesses — estimate_auto
   //    finds them by its guess -> estimate -> guess iteration.
-  EstimatorConfig cfg = preset_config(ModelKind::deadzone_deadband, Preset::lash, plant.dt_s());
+  EstimatorConfig cfg(ModelKind::deadzone_deadband, plant.dt_s());
   tune_to_data(cfg, analyse_record(rec.col("v"), rec.col("y"), plant.dt_s()));
   const AutoRun fit = estimate_auto(cfg, rec.col("v"), rec.col("y"));
   const EstimationRun& run = fit.run;

@@ -8,73 +8,40 @@
 #include "convert.hpp"
 #include "lash/identify/any_estimator.hpp"
 #include "lash/identify/auto.hpp"
-#include "lash/identify/config_file.hpp"
+#include "lash/identify/config_sources.hpp"
 #include "lash/identify/data.hpp"
 #include "lash/identify/estimate.hpp"
+#include "lash/identify/estimate_report.hpp"
 #include "lash/io/error.hpp"
 
 namespace lash::py {
 
 namespace {
 
-Preset preset_of(const std::string& name) {
-  return checked("preset", [&] { return parse_preset(name); });
-}
-
-ModelKind model_of(const std::string& name) {
-  return checked("model", [&] { return parse_model_kind(name); });
-}
-
-/// As `lash estimate` assembles them: the preset's settings, those chosen from the record (preset
-/// lash, when v and y are given), then the keys of an estimator config file (docs/identification.md).
-EstimatorConfig configure(EstimationJob& job, const std::string& model, const std::string& preset, double dt_s,
-                          const pyb::dict& settings, std::span<const double> v = {}, std::span<const double> y = {}) {
-  const ModelKind m = model_of(model);
-  const Preset p = preset_of(preset);
-  EstimatorConfig cfg = preset_config(m, p);
-  cfg.dt_s = dt_s;
-  if (p == Preset::lash && !v.empty()) tune_to_data(cfg, analyse_record(v, y, dt_s));
+/// The settings as `lash estimate` resolves them (lash::resolve_settings): the preset's, those chosen
+/// from the record (preset lash, when v and y are given), then the keyword arguments as the keys of an
+/// estimator config file (docs/identification.md); a key the model does not read is refused.
+EstimateSettings configure(const std::string& model, const std::string& preset, double dt_s,
+                           const pyb::dict& settings, std::span<const double> v = {}, std::span<const double> y = {}) {
+  SettingsSources src;
+  src.model = checked("model", [&] { return parse_model_kind(model); });
+  src.preset = checked("preset", [&] { return parse_preset(preset); });
   const toml::table tbl = to_toml(settings);
-  TomlTable t(tbl, "");
-  read_estimator_config(t, cfg, &job);
-  cfg.model = m;
-  return cfg;
+  src.keys = &tbl;
+  return resolve_settings(src, dt_s, v, y);
 }
 
-void validate(EstimatorConfig& cfg, const EstimationJob& job, double dt_s) {
-  cfg = config_for_record(cfg, job, dt_s);
-  checked("", [&] { cfg.validate(); });
-}
-
-pyb::object num(double x) { return std::isfinite(x) ? pyb::object(pyb::float_(x)) : pyb::object(pyb::none()); }
 
 struct Result {
   EstimateResult res;
-  std::string json;
+  std::string json;         // estimate_json: the report without what estimate_auto adds
+  std::string cli_json;     // lash.estimate: what `lash estimate --json` prints (estimate_auto_json)
   pyb::object yhat = pyb::none(), ysim = pyb::none(), params = pyb::none();
-  // what lash.estimate adds as `lash estimate --json` does (estimate_auto's report)
-  std::optional<AutoRun> autorun;
-  std::string preset;
 
   explicit Result(EstimateResult r) : res(std::move(r)), json(to_json(res)) {}
+  Result(EstimateResult r, std::string cli) : res(std::move(r)), json(to_json(res)), cli_json(std::move(cli)) {}
   pyb::dict to_dict() const {
-    pyb::dict d = pyb::module_::import("json").attr("loads")(json);
-    if (!autorun) return d;
-    auto put_guess = [&](const char* side, const GuessReport& g) {
-      if (!d.contains(side) || g.source == GuessSource::unused) return;
-      pyb::dict s = d[side];
-      if (g.wrong_side) s["reason"] = "wrong_guess";
-      pyb::dict gd;
-      gd["value"] = num(g.guess);
-      gd["source"] = to_string(g.source);
-      gd["edge_seen"] = num(g.edge);
-      s["guess"] = gd;
-    };
-    put_guess("right", autorun->right);
-    put_guess("left", autorun->left);
-    d["outliers"] = autorun->outliers;
-    d["preset"] = preset;
-    return d;
+    return pyb::module_::import("json").attr("loads")(cli_json.empty() ? json : cli_json);
   }
 };
 
@@ -82,8 +49,9 @@ class Estimator {
  public:
   Estimator(const std::string& model, double dt_s, const std::string& preset, const pyb::kwargs& settings) {
     if (!(dt_s > 0) || !std::isfinite(dt_s)) throw InputError("", 0, "dt", "must be a finite number > 0 [s]");
-    cfg_ = configure(job_, model, preset, dt_s, settings);
-    validate(cfg_, job_, dt_s);
+    EstimateSettings set = configure(model, preset, dt_s, settings);
+    cfg_ = set.cfg;
+    job_ = set.job;
     est_ = std::make_unique<AnyEstimator>(cfg_);
   }
 
@@ -165,8 +133,7 @@ class Estimator {
 Result estimate(const pyb::handle& t_obj, const pyb::handle& v_obj, const pyb::handle& y_obj, const std::string& model,
                 const std::string& preset, double outlier_gate, bool trace, bool intervals,
                 const pyb::kwargs& settings) {
-  EstimationJob job;
-  configure(job, model, preset, 1.0, settings);  // settings are checked before the data is looked at
+  configure(model, preset, 0.0, settings);  // settings are checked before the data is looked at
   const Doubles ta(t_obj, "t"), va(v_obj, "v"), ya(y_obj, "y");
   va.require_length_of(ta);
   ya.require_length_of(ta);
@@ -175,18 +142,21 @@ Result estimate(const pyb::handle& t_obj, const pyb::handle& v_obj, const pyb::h
   // as load_record: dt is the mean step without the gaps, and the estimator restarts at each gap
   const Sampling smp = analyse_sampling(std::vector<double>(t.begin(), t.end()));
   const double dt = smp.dt;
-  EstimatorConfig cfg = configure(job, model, preset, dt, settings, v, y);
-  validate(cfg, job, dt);
+  const EstimateSettings set = configure(model, preset, dt, settings, v, y);
   std::optional<AutoRun> ar;
   std::optional<EstimateResult> res;
   {
     pyb::gil_scoped_release nogil;
-    ar.emplace(estimate_auto(cfg, v, y, trace, outlier_gate, smp.gap_rows));
+    ar.emplace(estimate_auto(set.cfg, v, y, trace, outlier_gate, smp.gap_rows));
     if (intervals) add_intervals(ar->run, ar->cfg, v, y, smp.gap_rows);
-    res.emplace(score_estimate(ar->run.report, dt, job, t, y, ar->run.ysim));
+    res.emplace(score_estimate(ar->run.report, dt, set.job, t, y, ar->run.ysim));
   }
   EstimationRun* run = &ar->run;
-  Result r(std::move(*res));
+  ReportFit fit = report_fit(*res);  // as the CLI's: gaps and the median step of t too
+  fit.gaps = smp.gap_rows.size();
+  fit.median_dt_s = smp.median_dt;
+  std::string json = estimate_auto_json(*ar, set.preset, fit);
+  Result r(std::move(*res), std::move(json));
   r.yhat = to_numpy(std::move(run->yhat));
   r.ysim = to_numpy(std::move(run->ysim));
   if (trace) {
@@ -195,9 +165,6 @@ Result estimate(const pyb::handle& t_obj, const pyb::handle& v_obj, const pyb::h
       p[pyb::str(run->param_names[i])] = to_numpy(std::move(run->params[i]));
     r.params = p;
   }
-  run->params.clear();
-  r.autorun = std::move(ar);
-  r.preset = to_string(preset_of(preset));
   return r;
 }
 
@@ -217,7 +184,7 @@ void bind_estimate(pyb::module_& m) {
   pyb::class_<Result>(m, "Result", "What `lash estimate` reports about one record (see to_dict()).")
       .def("to_dict", &Result::to_dict,
            "The object `lash estimate --json` prints for the same data and settings (the same library function).")
-      .def_property_readonly("json", [](const Result& r) { return r.json; }, "to_dict() as JSON text (one line).")
+      .def_property_readonly("json", [](const Result& r) { return r.json; }, "The report as JSON text (one line): to_dict() without guess, outliers and preset.")
       .def_property_readonly("model", [](const Result& r) { return std::string(to_string(r.res.report.model)); })
       .def_property_readonly("samples", [](const Result& r) { return r.res.report.samples; },
                              "Samples stepped, including skipped ones.")

@@ -56,9 +56,7 @@ ControllerConfig design_for_rise(const FirstOrderDeadzoneModel& m, double bias_k
 FirstOrderDeadzoneModel identify_online_on_rig(const rigs::PilotValveRigParams& rp, double dt_s, std::uint64_t seed,
                                                double duration_s, double deadzone_guess_mA) {
   rigs::PilotValveRig rig(rp, dt_s, seed);
-  EstimatorConfig ec;
-  ec.model = ModelKind::input_deadzone;
-  ec.dt_s = dt_s;
+  EstimatorConfig ec = EstimatorConfig::thesis(ModelKind::input_deadzone, dt_s);
   ec.guess_right = deadzone_guess_mA;
   ec.guess_left = -deadzone_guess_mA;
   ec.rls.lambda = 0.995;

@@ -52,25 +52,19 @@ void read_estimator(TomlTable& t, EstimatorConfig& e, rigs::RigKind kind) {
 }  // namespace
 
 EstimatorConfig thesis_estimator(rigs::RigKind kind, double dt_s) {
-  EstimatorConfig e;
-  e.dt_s = dt_s;
-  e.rls.lambda = 0.99;
-  e.rls.p0 = 1000.0;
-  e.rls.eta0 = {1.0, 1.0, 1.0};
+  const ModelKind model = kind == rigs::RigKind::motor_cart    ? ModelKind::output_deadzone
+                          : kind == rigs::RigKind::pilot_valve ? ModelKind::input_deadzone
+                                                               : ModelKind::coupled_carts;
+  EstimatorConfig e = EstimatorConfig::thesis(model, dt_s);
   switch (kind) {
-    case rigs::RigKind::motor_cart: e.model = ModelKind::output_deadzone; break;
+    case rigs::RigKind::motor_cart: break;
     case rigs::RigKind::pilot_valve:
-      e.model = ModelKind::input_deadzone;
       e.guess_left = -500.0;
       e.guess_right = 500.0;
       e.rls.lower = {-1.0, 0.0001, -500.0};
       e.rls.upper = {0.0, 2.0, 500.0};
       break;
-    case rigs::RigKind::coupled_carts:
-      e.model = ModelKind::coupled_carts;
-      e.accel_limit = 1.0;
-      e.stage2_start_s = 7.5;
-      break;
+    case rigs::RigKind::coupled_carts: break;  // the thesis's |acceleration| <= 1 m/s^2, stage 2 from 7.5 s
   }
   return e;
 }

@@ -137,8 +137,7 @@ void read_compensation(TomlTable& c, ClosedLoopScenario& s) {
 
 // The estimator defaults of each rig (overridable key by key in [compensation.estimator]).
 EstimatorConfig default_estimator(const ClosedLoopScenario& s) {
-  EstimatorConfig e;
-  e.dt_s = s.dt_s;
+  EstimatorConfig e = EstimatorConfig::thesis(ModelKind::deadzone_deadband, s.dt_s);
   if (s.rig == rigs::RigKind::pilot_valve) {
     e.model = ModelKind::input_deadzone;
     // Updates only well beyond the nominal edges: samples near the edge mix deadzone and slope.
@@ -160,8 +159,7 @@ EstimatorConfig default_estimator(const ClosedLoopScenario& s) {
 // after the clearance drift (measured: unphysical on both sides from 25 s on).
 BacklashEstimatorConfig default_backlash_estimator(const ClosedLoopScenario& s) {
   BacklashEstimatorConfig e;
-  e.model = ModelKind::deadzone_deadband;
-  e.dt_s = s.dt_s;
+  static_cast<EstimatorConfig&>(e) = EstimatorConfig::thesis(ModelKind::deadzone_deadband, s.dt_s);
   e.input_shift = 2.0 * s.rig_config.coupled_carts.half_clearance_m;
   e.guess_right = 1.5 * e.input_shift;
   e.guess_left = -1.5 * e.input_shift;

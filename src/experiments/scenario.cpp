@@ -87,6 +87,7 @@ ScenarioSpec load_scenario(const std::filesystem::path& path) {
   }
   {
     TomlTable e = t.table("estimator");
+    s.estimator = EstimatorConfig::thesis(ModelKind::deadzone_deadband);  // the file's keys over the thesis's settings
     read_estimator_config(e, s.estimator);
   }
   t.finish();

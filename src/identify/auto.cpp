@@ -4,7 +4,6 @@
 #include <cstdlib>
 #include <cmath>
 #include <limits>
-#include <sstream>
 #include <stdexcept>
 #include <vector>
 
@@ -24,9 +23,7 @@ double quantile(std::vector<double> x, double q) {
   return x[k];
 }
 
-bool uses_guesses(ModelKind m) noexcept {
-  return m == ModelKind::input_deadzone || m == ModelKind::deadzone_deadband;
-}
+bool uses_guesses(ModelKind m) noexcept { return contains(InputSwitchingSettings::models, m); }
 
 /// The deadzone edge a side's regression points at, identified or not (NaN when there is none).
 double raw_edge(const AnyEstimator& est, Side s) {
@@ -48,15 +45,6 @@ double raw_edge(const AnyEstimator& est, Side s) {
   return kNaN;
 }
 
-std::string num(double x) {
-  if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
-  std::ostringstream s;
-  s.precision(17);
-  s << x;
-  std::string t = s.str();
-  if (t.find_first_of(".eEn") == std::string::npos) t += ".0";
-  return t;
-}
 }  // namespace
 
 Preset parse_preset(std::string_view name) {
@@ -77,67 +65,7 @@ const char* to_string(GuessSource s) noexcept {
 }
 
 EstimatorConfig preset_config(ModelKind model, Preset preset, double dt_s) {
-  EstimatorConfig c;  // the thesis's settings (§1.5.1)
-  c.model = model;
-  c.dt_s = dt_s;
-  c.rls.lambda = 0.99;
-  c.rls.p0 = 1000.0;
-  c.rls.eta0 = {1.0, 1.0, 1.0};
-  if (model == ModelKind::coupled_carts) {
-    c.accel_limit = 1.0;  // thesis §1.6.3: |free-cart acceleration| ≤ 1 m/s²
-    c.stage2_start_s = 7.5;
-  }
-  if (preset == Preset::thesis) return c;
-  switch (model) {
-    case ModelKind::deadzone_deadband:
-      // E2's method (docs/identification.md "E2: what got how far"): consistent MA40 on v and y,
-      // switching on a filtered derivative with a dead band, direction held over the filter window,
-      // one pooled 4-parameter regression per side solved by recursive IV, every sample kept.
-      c.pooled = true;
-      c.method = EstimationMethod::iv;
-      c.iv_delay = 45;
-      c.direction_run = 41;
-      c.rls.lambda = 1.0;
-      c.noise.filter_length = 40;
-      c.noise.filter_input = true;
-      c.noise.derivative_filter_length = 20;
-      c.noise.derivative_threshold = 150.0;
-      c.noise.align_delay = 10;
-      break;
-    case ModelKind::input_deadzone:
-      // E4 (lash settings): λ 0.995, a1 ∈ [−1, 0] (stable, non-oscillating first order), b1 ≥ 0.
-      c.rls.lambda = 0.995;
-      c.rls.lower = {-1.0, 0.0, -kInf};
-      c.rls.upper = {0.0, kInf, kInf};
-      break;
-    case ModelKind::output_deadzone:
-      // E3 (lash settings): directional forgetting; λ from the sample time. No moving average: its
-      // start-up ramp would make a constant input look excited (the verdict reads v over the updates).
-      c.rls.lambda = 0.9995;
-      c.rls.forgetting = Forgetting::directional;
-      break;
-    case ModelKind::linear:
-      c.rls.lambda = 0.9995;
-      break;
-    case ModelKind::coupled_carts:
-      c.rls.lambda = 0.995;  // E5 (lash settings)
-      c.stage2_start_s = 5.0;
-      break;
-  }
-  return c;
-}
-
-bool model_uses(ModelKind m, std::string_view s) noexcept {
-  const bool dzdb = m == ModelKind::deadzone_deadband;
-  if (s == "guess-left" || s == "guess-right") return uses_guesses(m);
-  if (s == "pooled" || s == "direction-run") return dzdb;
-  if (s == "method" || s == "iv-delay") return m != ModelKind::coupled_carts;
-  if (s == "accel-limit" || s == "stage2-start") return m == ModelKind::coupled_carts;
-  if (s == "zero-threshold") return m == ModelKind::output_deadzone;
-  if (s == "derivative-threshold" || s == "derivative-filter-length" || s == "derivative-prefilter-length" ||
-      s == "align-delay")
-    return dzdb || m == ModelKind::coupled_carts;
-  return true;
+  return preset == Preset::thesis ? EstimatorConfig::thesis(model, dt_s) : EstimatorConfig(model, dt_s);
 }
 
 DataTraits analyse_record(std::span<const double> v, std::span<const double> y, double dt_s) {
@@ -327,56 +255,6 @@ std::array<double, 2> search_guesses(const EstimatorConfig& cfg0, std::span<cons
     if (!moved) break;
   }
   return {g[0] > 0.0 ? g[0] : kInf, g[1] < 0.0 ? g[1] : -kInf};
-}
-
-std::string config_to_toml(const EstimatorConfig& c) {
-  std::ostringstream o;
-  const auto tri = [&](const std::array<double, 3>& a) {
-    return "[" + num(a[0]) + ", " + num(a[1]) + ", " + num(a[2]) + "]";
-  };
-  // TOML files hold finite numbers only: a non-finite value (the "none" of a guess, a bound or the
-  // acceleration gate) is the default of every base, so it is written as a comment
-  const auto key = [&](const char* k, double x) {
-    if (!std::isfinite(x)) o << "# ";
-    o << k << " = " << num(x) << "\n";
-  };
-  const auto key3 = [&](const char* k, const std::array<double, 3>& a) {
-    if (!(std::isfinite(a[0]) && std::isfinite(a[1]) && std::isfinite(a[2]))) o << "# ";
-    o << k << " = " << tri(a) << "\n";
-  };
-  o << "# lash estimate settings (docs/identification.md); lash estimate --config FILE reads them back\n";
-  o << "model = \"" << to_string(c.model) << "\"\n";
-  o << "method = \"" << to_string(c.method) << "\"\n";
-  key("guess_left", c.guess_left);
-  key("guess_right", c.guess_right);
-  o << "pooled = " << (c.pooled ? "true" : "false") << "\n";
-  o << "sim_side_by_sign = " << (c.sim_side_by_sign ? "true" : "false") << "\n";
-  o << "iv_delay = " << c.iv_delay << "\n";
-  o << "direction_run = " << c.direction_run << "\n";
-  o << "min_updates = " << c.min_updates << "\n";
-  o << "singular_tol = " << num(c.singular_tol) << "\n";
-  o << "settle_tol = " << num(c.settle_tol) << "\n";
-  o << "settle_updates = " << c.settle_updates << "\n";
-  o << "zero_threshold = " << num(c.zero_threshold) << "\n";
-  key("accel_limit", c.accel_limit);
-  o << "stage2_start = " << num(c.stage2_start_s) << "\n\n";
-  o << "[rls]\n";
-  o << "lambda = " << num(c.rls.lambda) << "\n";
-  o << "p0 = " << num(c.rls.p0) << "\n";
-  o << "eta0 = " << tri(c.rls.eta0) << "\n";
-  key3("lower", c.rls.lower);
-  key3("upper", c.rls.upper);
-  o << "trace_max = " << num(c.rls.trace_max) << "\n";
-  o << "forgetting = \"" << to_string(c.rls.forgetting) << "\"\n\n";
-  o << "[noise]\n";
-  o << "filter_length = " << c.noise.filter_length << "\n";
-  o << "filter_input = " << (c.noise.filter_input ? "true" : "false") << "\n";
-  o << "input_delay = " << c.noise.input_delay << "\n";
-  o << "derivative_prefilter_length = " << c.noise.derivative_prefilter_length << "\n";
-  o << "derivative_filter_length = " << c.noise.derivative_filter_length << "\n";
-  o << "derivative_threshold = " << num(c.noise.derivative_threshold) << "\n";
-  o << "align_delay = " << c.noise.align_delay << "\n";
-  return o.str();
 }
 
 }  // namespace lash

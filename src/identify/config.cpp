@@ -1,6 +1,7 @@
 #include "lash/identify/config.hpp"
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -49,16 +50,8 @@ void require(bool ok, const char* field, const std::string& msg) {
 }
 }  // namespace
 
-void EstimatorConfig::validate() const {
+void CommonSettings::validate() const {
   require(std::isfinite(dt_s) && dt_s > 0, "dt", "sample period must be > 0 [s]");
-  require(!std::isnan(guess_left) && !std::isnan(guess_right), "guess", "guesses must be numbers");
-  const bool needs_guesses = model == ModelKind::input_deadzone || model == ModelKind::deadzone_deadband;
-  if (needs_guesses) {
-    // an infinite guess means "not given": lash::estimate_auto searches it (auto.hpp); a bare
-    // estimator never updates that side
-    require(guess_left < guess_right, "guess-left",
-            "guess-left must be < guess-right (the guesses lie outside the deadzone: c_l* < c_l <= c_r < c_r*)");
-  }
   require(rls.lambda > 0 && rls.lambda <= 1, "lambda", "forgetting factor must be in (0, 1]");
   require(std::isfinite(rls.p0) && rls.p0 > 0, "p0", "initial covariance must be > 0");
   require(rls.trace_max > 0, "trace-max", "must be > 0");
@@ -67,25 +60,110 @@ void EstimatorConfig::validate() const {
     require(!std::isnan(rls.lower[i]) && !std::isnan(rls.upper[i]) && rls.lower[i] <= rls.upper[i], "bounds",
             "need lower <= upper");
   }
-  require(noise.filter_length >= 1 && noise.filter_length <= 100000, "filter-length", "must be in 1..100000");
-  require(noise.derivative_filter_length >= 1 && noise.derivative_filter_length <= 100000,
-          "derivative-filter-length", "must be in 1..100000");
-  require(noise.derivative_prefilter_length <= 100000, "derivative-prefilter-length", "must be in 0..100000");
-  require(noise.input_delay <= 100000, "input-delay", "must be <= 100000 samples");
-  require(noise.align_delay <= 100000, "align-delay", "must be <= 100000 samples");
-  require(std::isfinite(noise.derivative_threshold) && noise.derivative_threshold >= 0, "derivative-threshold",
-          "must be >= 0 [y unit/s]");
-  require(iv_delay >= 1 && iv_delay <= 60, "iv-delay", "must be in 1..60 samples");
-  require(direction_run >= 2 && direction_run <= 1000000, "direction-run", "must be in 2..1000000 samples");
+  noise.RegressionFilterSettings::validate();
   require(min_updates >= 1, "min-updates", "must be >= 1");
+  require(std::isfinite(fit_threshold) && fit_threshold > 0, "fit-threshold", "must be > 0 (a fraction: 0.2 = 20 %)");
+  require(std::isfinite(fit_start_s) && fit_start_s >= 0, "fit-start", "must be >= 0 [s]");
+}
+
+void RegressionFilterSettings::validate() const {
+  require(filter_length >= 1 && filter_length <= 100000, "filter-length", "must be in 1..100000");
+  require(input_delay <= 100000, "input-delay", "must be <= 100000 samples");
+}
+
+void DerivativeSwitchingSettings::validate() const {
+  require(derivative_filter_length >= 1 && derivative_filter_length <= 100000, "derivative-filter-length",
+          "must be in 1..100000");
+  require(derivative_prefilter_length <= 100000, "derivative-prefilter-length", "must be in 0..100000");
+  require(align_delay <= 100000, "align-delay", "must be <= 100000 samples");
+  require(std::isfinite(derivative_threshold) && derivative_threshold >= 0, "derivative-threshold",
+          "must be >= 0 [y unit/s]");
+}
+
+void MethodSettings::validate() const {
+  require(iv_delay >= 1 && iv_delay <= 60, "iv-delay", "must be in 1..60 samples");
+}
+
+void InputSwitchingSettings::validate() const {
+  require(!std::isnan(guess_left) && !std::isnan(guess_right), "guess", "guesses must be numbers");
+  // an infinite guess means "not given": lash::estimate_auto searches it (auto.hpp); a bare
+  // estimator never updates that side
+  require(guess_left < guess_right, "guess-left",
+          "guess-left must be < guess-right (the guesses lie outside the deadzone: c_l* < c_l <= c_r < c_r*)");
+}
+
+void DeadzoneDeadbandSettings::validate() const {
+  require(direction_run >= 2 && direction_run <= 1000000, "direction-run", "must be in 2..1000000 samples");
   require(std::isfinite(settle_tol) && settle_tol > 0, "settle-tol", "must be > 0");
   require(settle_updates <= 1000000, "settle-updates", "must be <= 1000000");
   require(std::isfinite(singular_tol) && singular_tol > 0, "singular-tol", "must be > 0");
+}
+
+void OutputDeadzoneSettings::validate() const {
   require(std::isfinite(zero_threshold) && zero_threshold >= 0, "zero-threshold", "must be >= 0");
+}
+
+void CoupledCartsSettings::validate() const {
   require(accel_limit > 0, "accel-limit", "must be > 0");
-  require(std::isfinite(fit_threshold) && fit_threshold > 0, "fit-threshold", "must be > 0 (a fraction: 0.2 = 20 %)");
-  require(std::isfinite(fit_start_s) && fit_start_s >= 0, "fit-start", "must be >= 0 [s]");
   require(std::isfinite(stage2_start_s) && stage2_start_s >= 0, "stage2-start", "must be >= 0 [s]");
+}
+
+EstimatorConfig::EstimatorConfig(ModelKind m, double dt) {
+  model = m;
+  dt_s = dt;
+  // lash's data-independent settings per model (docs/identification.md "Defaults chosen from the
+  // data"); the settings that depend on the record come on top (tune_to_data, auto.hpp)
+  switch (m) {
+    case ModelKind::deadzone_deadband:
+      // E2's method (docs/identification.md "E2: what got how far"): consistent MA40 on v and y,
+      // switching on a filtered derivative with a dead band, direction held over the filter window
+      // (direction_run 41, pooled: the struct's defaults), one pooled 4-parameter regression per
+      // side solved by recursive IV, every sample kept.
+      method = EstimationMethod::iv;
+      iv_delay = 45;
+      rls.lambda = 1.0;
+      noise.filter_length = 40;
+      noise.filter_input = true;
+      noise.derivative_filter_length = 20;
+      noise.derivative_threshold = 150.0;
+      noise.align_delay = 10;
+      break;
+    case ModelKind::input_deadzone:
+      // E4 (lash settings): λ 0.995, a1 ∈ [−1, 0] (stable, non-oscillating first order), b1 ≥ 0.
+      rls.lambda = 0.995;
+      rls.lower = {-1.0, 0.0, -std::numeric_limits<double>::infinity()};
+      rls.upper = {0.0, std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+      break;
+    case ModelKind::output_deadzone:
+      // E3 (lash settings): directional forgetting; λ from the sample time. No moving average: its
+      // start-up ramp would make a constant input look excited (the verdict reads v over the updates).
+      rls.lambda = 0.9995;
+      rls.forgetting = Forgetting::directional;
+      break;
+    case ModelKind::linear: rls.lambda = 0.9995; break;
+    case ModelKind::coupled_carts: rls.lambda = 0.995; break;  // E5 (lash settings)
+  }
+}
+
+EstimatorConfig EstimatorConfig::thesis(ModelKind m, double dt) {
+  EstimatorConfig c(m, dt);
+  c.rls = RlsSettings{};                              // λ = 0.99, P0 = 1000·I, η0 = [1 1 1]
+  c.noise = NoiseSettings{};
+  static_cast<MethodSettings&>(c) = MethodSettings{};
+  c.pooled = false;
+  c.direction_run = 2;  // y(k) > y(k−1) > y(k−2)
+  c.stage2_start_s = 7.5;
+  return c;
+}
+
+void EstimatorConfig::validate() const {
+  CommonSettings::validate();
+  if (contains(DerivativeSwitchingSettings::models, model)) noise.DerivativeSwitchingSettings::validate();
+  if (contains(MethodSettings::models, model)) MethodSettings::validate();
+  if (contains(InputSwitchingSettings::models, model)) InputSwitchingSettings::validate();
+  if (contains(DeadzoneDeadbandSettings::models, model)) DeadzoneDeadbandSettings::validate();
+  if (contains(OutputDeadzoneSettings::models, model)) OutputDeadzoneSettings::validate();
+  if (contains(CoupledCartsSettings::models, model)) CoupledCartsSettings::validate();
   if (method == EstimationMethod::iv)
     require(rls.forgetting == Forgetting::exponential, "forgetting", "iv supports exponential forgetting only");
 }

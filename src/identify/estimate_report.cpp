@@ -112,4 +112,31 @@ std::string estimate_text(const EstimateReport& r, double dt_s, const ReportFit&
   return out;
 }
 
+std::string estimate_auto_json(const AutoRun& ar, Preset preset, const ReportFit& fit) {
+  Json j = Json::parse(estimate_json(ar.run.report, fit));
+  const auto put_guess = [&](const char* side, const GuessReport& g) {
+    if (!j.contains(side) || g.source == GuessSource::unused) return;
+    if (g.wrong_side) j[side]["reason"] = "wrong_guess";
+    j[side]["guess"] = {{"value", num(g.guess)}, {"source", to_string(g.source)}, {"edge_seen", num(g.edge)}};
+  };
+  put_guess("right", ar.right);
+  put_guess("left", ar.left);
+  j["outliers"] = ar.outliers;
+  j["preset"] = to_string(preset);
+  return j.dump();
+}
+
+std::string estimate_auto_text(const AutoRun& ar, double dt_s, const ReportFit& fit) {
+  std::string out = estimate_text(ar.run.report, dt_s, fit);
+  for (const auto& [name, g] : {std::pair{"right", &ar.right}, std::pair{"left", &ar.left}}) {
+    if (g->wrong_side)
+      out += fmt::format("wrong_guess: the {} guess {:.6g} lies inside the deadzone (edge seen at {:.6g})\n", name,
+                         g->guess, g->edge);
+    else if (g->source != GuessSource::unused)
+      out += fmt::format("{} guess: {:.6g} ({})\n", name, g->guess, to_string(g->source));
+  }
+  if (ar.outliers > 0) out += fmt::format("outliers: {} samples of y replaced by the outlier gate\n", ar.outliers);
+  return out;
+}
+
 }  // namespace lash

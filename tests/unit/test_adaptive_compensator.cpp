@@ -24,8 +24,7 @@ BacklashCompensationConfig carts(CompensationMode mode) {
   BacklashCompensationConfig c;
   c.mode = mode;
   c.nominal = {0.005, 0.005, 0.0};
-  c.estimator.model = ModelKind::deadzone_deadband;
-  c.estimator.dt_s = kDt;
+  static_cast<EstimatorConfig&>(c.estimator) = EstimatorConfig::thesis(ModelKind::deadzone_deadband, kDt);
   c.estimator.input_shift = 0.01;
   c.estimator.guess_right = 0.015;
   c.estimator.guess_left = -0.015;
@@ -39,7 +38,7 @@ DeadzoneCompensationConfig valve(CompensationMode mode) {
   c.mode = mode;
   c.nominal.offset_right = 288.0;
   c.nominal.offset_left = 296.0;
-  c.estimator.model = ModelKind::input_deadzone;
+  c.estimator = EstimatorConfig::thesis(ModelKind::input_deadzone, c.estimator.dt_s);
   c.estimator.guess_right = 432.0;
   c.estimator.guess_left = -444.0;
   return c;

@@ -47,13 +47,13 @@ constexpr double kDt = 0.005;
 /// Settings per estimator type (the switching guesses where the model needs them).
 template <class E>
 EstimatorConfig config_for() {
-  EstimatorConfig c;
-  c.dt_s = kDt;
-  if constexpr (std::is_same_v<E, LinearEstimator>) c.model = ModelKind::linear;
-  if constexpr (std::is_same_v<E, InputDeadzoneEstimator>) c.model = ModelKind::input_deadzone;
-  if constexpr (std::is_same_v<E, OutputDeadzoneEstimator>) c.model = ModelKind::output_deadzone;
-  if constexpr (std::is_same_v<E, DeadzoneDeadbandEstimator>) c.model = ModelKind::deadzone_deadband;
-  if constexpr (std::is_same_v<E, CoupledCartsEstimator>) c.model = ModelKind::coupled_carts;
+  ModelKind m = ModelKind::linear;
+  if constexpr (std::is_same_v<E, InputDeadzoneEstimator>) m = ModelKind::input_deadzone;
+  if constexpr (std::is_same_v<E, OutputDeadzoneEstimator>) m = ModelKind::output_deadzone;
+  if constexpr (std::is_same_v<E, DeadzoneDeadbandEstimator>) m = ModelKind::deadzone_deadband;
+  if constexpr (std::is_same_v<E, CoupledCartsEstimator>) m = ModelKind::coupled_carts;
+  EstimatorConfig c = EstimatorConfig::thesis(m, kDt);
+  c.accel_limit = std::numeric_limits<double>::infinity();  // coupled carts: no acceleration gate
   c.guess_left = -350.0;
   c.guess_right = 350.0;
   return c;

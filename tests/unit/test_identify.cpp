@@ -175,9 +175,7 @@ TEST(Rls, DirectionalForgettingTracksAChange) {
 // ------------------------------------------------------------------------------------------ E1
 
 EstimatorConfig thesis_config() {
-  EstimatorConfig c;
-  c.model = ModelKind::deadzone_deadband;
-  c.dt_s = 0.005;
+  EstimatorConfig c = EstimatorConfig::thesis(ModelKind::deadzone_deadband, 0.005);
   c.guess_left = -350;
   c.guess_right = 350;
   c.rls.lambda = 0.99;
@@ -256,9 +254,8 @@ AnyEstimator estimate(const EstimatorConfig& c, const Record& r) {
 }
 
 EstimatorConfig base(ModelKind m, double dt) {
-  EstimatorConfig c;
-  c.model = m;
-  c.dt_s = dt;
+  EstimatorConfig c = EstimatorConfig::thesis(m, dt);
+  c.accel_limit = std::numeric_limits<double>::infinity();  // coupled carts: no acceleration gate
   c.rls.lambda = 1.0;
   c.rls.p0 = 1e8;
   c.rls.eta0 = {0, 0, 0};

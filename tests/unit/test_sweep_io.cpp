@@ -128,9 +128,7 @@ std::pair<double, double> emps_coulomb(const fs::path& mat) {
   EXPECT_EQ(t.string("model"), "output-deadzone");
   const auto columns = t.strings("columns");
   auto rls = t.table("rls");
-  lash::EstimatorConfig e;
-  e.model = lash::ModelKind::output_deadzone;
-  e.dt_s = 0.001;
+  lash::EstimatorConfig e = lash::EstimatorConfig::thesis(lash::ModelKind::output_deadzone, 0.001);
   e.rls.lambda = rls.number("lambda");
   e.rls.p0 = rls.number("p0");
   const auto eta0 = rls.numbers("eta0");

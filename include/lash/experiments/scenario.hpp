@@ -25,7 +25,7 @@ struct ScenarioSpec {
   double noise_variance = 0.0;        ///< [y unit²]
   std::vector<std::uint64_t> seeds{1};
   std::vector<double> checkpoints_s;  ///< times at which estimates are reported (last = duration)
-  EstimatorConfig estimator;          ///< dt_s comes from the plant
+  EstimatorConfig estimator;          ///< the [estimator] keys over the thesis's settings; dt_s comes from the plant
   PerSide<SideParams> truth;          ///< NaN = parameter not part of the model
   double outside_t0_s = 50.0, outside_t1_s = 200.0;  ///< window of the ±3σ count
   double nrmse_t0_s = 7.5, nrmse_t1_s = 200.0;

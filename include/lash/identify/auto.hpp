@@ -28,12 +28,9 @@ enum class Preset : std::uint8_t {
 Preset parse_preset(std::string_view name);
 const char* to_string(Preset p) noexcept;
 
-/// The static settings of `model` for `preset` (before any data is seen), sample period dt_s.
+/// The static settings of `model` for `preset` (before any data is seen), sample period dt_s:
+/// EstimatorConfig(model, dt_s) (lash's) or EstimatorConfig::thesis(model, dt_s).
 EstimatorConfig preset_config(ModelKind model, Preset preset = Preset::lash, double dt_s = 0.005);
-
-/// Whether `model` reads a setting (names as in `lash estimate`'s options without the dashes:
-/// "guess-left", "method", "pooled", "accel-limit", …). An unknown name returns true.
-bool model_uses(ModelKind model, std::string_view setting) noexcept;
 
 /// What a record says about the settings that depend on it.
 struct DataTraits {
@@ -95,9 +92,5 @@ AutoRun estimate_auto(const EstimatorConfig& cfg, std::span<const double> v, std
 /// which runs its estimator online on a rig whose open-loop record it can take first.
 std::array<double, 2> search_guesses(const EstimatorConfig& cfg, std::span<const double> v,
                                      std::span<const double> y, std::span<const std::size_t> gap_rows = {});
-
-/// The settings as a TOML document that `read_estimator_config` (`lash estimate --config`)
-/// reads back to the same EstimatorConfig (every key written; infinities as ±inf).
-std::string config_to_toml(const EstimatorConfig& cfg);
 
 }  // namespace lash

@@ -47,8 +47,14 @@ struct RlsSettings {
                               std::numeric_limits<double>::infinity()};
 };
 
-/// Noise handling of SPEC A5 / thesis §1.4.5. Defaults pass the signals through untouched.
-struct NoiseSettings {
+/// A set of models (bit i = ModelKind i): which models read a settings struct.
+using ModelSet = std::uint8_t;
+constexpr ModelSet model_bit(ModelKind m) noexcept { return static_cast<ModelSet>(1u << static_cast<unsigned>(m)); }
+constexpr ModelSet kAllModels = 0x1f;
+constexpr bool contains(ModelSet set, ModelKind m) noexcept { return (set & model_bit(m)) != 0; }
+
+/// The moving averages on the regression signals (every model).
+struct RegressionFilterSettings {
   /// M-point moving average on y (the regression output) [samples]; 1 = off.
   std::size_t filter_length = 1;
   /// Pass v through the same moving average as y ("consistent filtering": the linear
@@ -56,6 +62,12 @@ struct NoiseSettings {
   bool filter_input = false;
   /// Pure delay of v [samples] that keeps v aligned with a filtered y when v itself is not filtered.
   std::size_t input_delay = 0;
+  static constexpr ModelSet models = kAllModels;
+  void validate() const;
+};
+
+/// Switching on the direction of motion ẏ (deadzone-deadband, coupled-carts).
+struct DerivativeSwitchingSettings {
   /// Moving average on y before the derivative is taken [samples]; 0 = the same filter as the
   /// regression's (filter_length). Lets the regression use raw y while switching uses a smooth ẏ.
   std::size_t derivative_prefilter_length = 0;
@@ -66,38 +78,22 @@ struct NoiseSettings {
   /// Delay of the regression signals (v and y after the filters above) so that they line up
   /// with the filtered ẏ used for switching [samples]. Typically (derivative_filter_length − 1)/2.
   std::size_t align_delay = 0;
+  static constexpr ModelSet models =
+      model_bit(ModelKind::deadzone_deadband) | model_bit(ModelKind::coupled_carts);
+  void validate() const;
 };
 
-struct EstimatorConfig {
+/// Noise handling of SPEC A5 / thesis §1.4.5. Defaults pass the signals through untouched.
+/// One struct per model group underneath, so `cfg.noise.derivative_threshold` reads as before.
+struct NoiseSettings : RegressionFilterSettings, DerivativeSwitchingSettings {};
+
+/// Settings every model reads.
+struct CommonSettings {
   ModelKind model = ModelKind::deadzone_deadband;
-  double dt_s = 0.005;                                  ///< sample period T [s]
-  double guess_left = -std::numeric_limits<double>::infinity();   ///< c_l* [v unit] (input-side switching)
-  double guess_right = std::numeric_limits<double>::infinity();   ///< c_r* [v unit]
+  double dt_s = 0.005;             ///< sample period T [s]
   RlsSettings rls;
   NoiseSettings noise;
-  EstimationMethod method = EstimationMethod::ls;
-  std::size_t iv_delay = 2;        ///< iv: the instrument for y(k−1) is y(k−1−iv_delay) [samples]
-  /// deadzone-deadband: one 4-parameter regression per side with a1, b1 shared between
-  /// directions (η = [a1, b1, −b1·c, d(1+a1)]) instead of the thesis's separate + and − RLS.
-  bool pooled = false;
-  /// deadzone-deadband: a key is updated only after the direction of motion (and the side of
-  /// v) has held for this many consecutive samples. 2 is the thesis's y(k) > y(k−1) > y(k−2);
-  /// with a moving-average filter of length M use ≥ M + 1 so the whole filter window lies in
-  /// one regime (then the filtered v and y obey the same linear relation exactly).
-  std::uint32_t direction_run = 2;
   std::uint64_t min_updates = 50;  ///< a key needs this many updates before its side is identified
-  /// deadzone-deadband: a side counts as identified only after (c, d) moved by at most
-  /// settle_tol·(|c| + |d|) per update for settle_updates updates in a row (the 2×2 solve of
-  /// eq. 31/32 amplifies a key that has not converged yet; this keeps such transients out).
-  double settle_tol = 0.01;
-  std::uint32_t settle_updates = 5;
-  double singular_tol = 1e-6;      ///< eq. 31/32: |det| below tol·(|a|+|b|) terms counts as singular
-  double zero_threshold = 0.0;     ///< output-deadzone: |y| ≤ this counts as 0 [y unit]
-  double accel_limit = std::numeric_limits<double>::infinity();  ///< coupled-carts stage 1: max |ÿ| [y unit/s²]
-  double stage2_start_s = 7.5;     ///< coupled-carts: deadband estimation starts here [s]
-  /// Free-run simulation inside the input deadzone: false = keep the a1 of the side last used
-  /// (thesis §1.4.2, SPEC A4); true = side by the sign of v(k−1) (eq. 34).
-  bool sim_side_by_sign = false;
   /// Verdict check 6 (verdict.hpp): a model whose free-run NRMSE (RMS(y − y_sim)/max|y|) over
   /// t ≥ fit_start_s exceeds this fraction is reported `poor_fit`. 0.2 = 20 %: far above what
   /// measurement noise alone gives on a fitting model (E2, noise variance 200: about 1.5 %).
@@ -105,8 +101,88 @@ struct EstimatorConfig {
   /// Start of the verdict's fit window [s] (the whole record when it ends earlier); 7.5 s is
   /// the thesis's NRMSE window start and `lash estimate`'s default --nrmse-window.
   double fit_start_s = 7.5;
+  static constexpr ModelSet models = kAllModels;
+  void validate() const;
+};
 
-  /// Throws std::invalid_argument naming the field.
+/// How the keyed regressions are solved (every model but coupled-carts, whose two stages are RLS).
+struct MethodSettings {
+  EstimationMethod method = EstimationMethod::ls;
+  std::size_t iv_delay = 2;  ///< iv: the instrument for y(k−1) is y(k−1−iv_delay) [samples]
+  static constexpr ModelSet models = kAllModels & ~model_bit(ModelKind::coupled_carts);
+  void validate() const;
+};
+
+/// Switching on the input against the guesses c_l*, c_r* (input-deadzone, deadzone-deadband).
+struct InputSwitchingSettings {
+  double guess_left = -std::numeric_limits<double>::infinity();  ///< c_l* [v unit]; −inf = searched
+  double guess_right = std::numeric_limits<double>::infinity();  ///< c_r* [v unit]; +inf = searched
+  /// Free-run simulation inside the input deadzone: false = keep the a1 of the side last used
+  /// (thesis §1.4.2, SPEC A4); true = side by the sign of v(k−1) (eq. 34).
+  bool sim_side_by_sign = false;
+  static constexpr ModelSet models =
+      model_bit(ModelKind::input_deadzone) | model_bit(ModelKind::deadzone_deadband);
+  void validate() const;
+};
+
+/// deadzone-deadband only. Defaults are lash's (E2's method); the thesis's: pooled false, direction_run 2.
+struct DeadzoneDeadbandSettings {
+  /// One 4-parameter regression per side with a1, b1 shared between directions
+  /// (η = [a1, b1, −b1·c, d(1+a1)]) instead of the thesis's separate + and − RLS.
+  bool pooled = true;
+  /// A key is updated only after the direction of motion (and the side of v) has held for this
+  /// many consecutive samples. 2 is the thesis's y(k) > y(k−1) > y(k−2); with a moving-average
+  /// filter of length M use ≥ M + 1 so the whole filter window lies in one regime.
+  std::uint32_t direction_run = 41;
+  /// A side counts as identified only after (c, d) moved by at most settle_tol·(|c| + |d|) per
+  /// update for settle_updates updates in a row (the 2×2 solve of eq. 31/32 amplifies a key
+  /// that has not converged yet; this keeps such transients out).
+  double settle_tol = 0.01;
+  std::uint32_t settle_updates = 5;
+  double singular_tol = 1e-6;  ///< eq. 31/32: |det| below tol·(|a|+|b|) terms counts as singular
+  static constexpr ModelSet models = model_bit(ModelKind::deadzone_deadband);
+  void validate() const;
+};
+
+/// output-deadzone only.
+struct OutputDeadzoneSettings {
+  double zero_threshold = 0.0;  ///< |y| ≤ this counts as 0 [y unit]
+  static constexpr ModelSet models = model_bit(ModelKind::output_deadzone);
+  void validate() const;
+};
+
+/// coupled-carts only. Defaults are lash's (before tune_to_data sets accel_limit from the record);
+/// the thesis's differ in stage2_start (7.5 s).
+struct CoupledCartsSettings {
+  /// Stage 1: max |ÿ| [y unit/s²]; +inf = no gate. 1 = the thesis's |free-cart acceleration| ≤ 1 m/s² (§1.6.3).
+  double accel_limit = 1.0;
+  double stage2_start_s = 5.0;  ///< deadband estimation starts here [s]
+  static constexpr ModelSet models = model_bit(ModelKind::coupled_carts);
+  void validate() const;
+};
+
+/// All settings of one estimator: the common part plus every per-model part, composed by
+/// inheritance so that each field keeps its short name (`cfg.pooled`, `cfg.rls.lambda`).
+/// A default-constructed config holds lash's data-independent defaults for its model
+/// (deadzone-deadband); `EstimatorConfig(model)` those of another model, and
+/// `EstimatorConfig::thesis(model)` the thesis's settings (§1.5.1). The settings chosen from a
+/// record come on top (auto.hpp: tune_to_data). The field table (config_fields.hpp) lists every
+/// field with its TOML key, CLI flag and the struct (hence the models) it belongs to.
+struct EstimatorConfig : CommonSettings,
+                         MethodSettings,
+                         InputSwitchingSettings,
+                         DeadzoneDeadbandSettings,
+                         OutputDeadzoneSettings,
+                         CoupledCartsSettings {
+  EstimatorConfig() : EstimatorConfig(ModelKind::deadzone_deadband) {}
+  /// lash's data-independent defaults for `model`, sample period dt_s [s].
+  explicit EstimatorConfig(ModelKind model, double dt_s = 0.005);
+  /// The thesis's settings (§1.5.1: RLS, λ = 0.99, P0 = 1000·I, η0 = [1 1 1], no filters;
+  /// coupled carts: |ÿ| ≤ 1, stage 2 from 7.5 s).
+  static EstimatorConfig thesis(ModelKind model, double dt_s = 0.005);
+
+  /// Validates the common part and every per-model part `model` reads (the others are not
+  /// read, so not checked). Throws std::invalid_argument naming the field.
   void validate() const;
   RlsConfig<3> rls3() const;
   RlsConfig<2> rls2() const;

@@ -20,6 +20,14 @@ struct EstimationJob {
 
 /// Reads every estimator key present in `table` into `cfg` (keys absent keep their value).
 /// `job` (optional) receives `columns` and `nrmse_window`. Calls table.finish().
+/// The keys are those of the field table (config_fields.hpp); a file may hold keys of models other
+/// than its own (they are read and unused).
 void read_estimator_config(TomlTable& table, EstimatorConfig& cfg, EstimationJob* job = nullptr);
+
+/// The settings as a TOML document that `read_estimator_config` (`lash estimate --config`) reads
+/// back to the same estimator: every key the model reads (the others do not change its result),
+/// non-finite values as commented lines (the default of every such key), and, with `job`, its
+/// `columns` and `nrmse_window`.
+std::string config_to_toml(const EstimatorConfig& cfg, const EstimationJob* job = nullptr);
 
 }  // namespace lash

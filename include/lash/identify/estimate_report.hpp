@@ -12,6 +12,7 @@
 #include <string>
 
 #include "lash/identify/any_estimator.hpp"
+#include "lash/identify/auto.hpp"
 
 namespace lash {
 
@@ -28,5 +29,13 @@ struct ReportFit {
 
 std::string estimate_json(const EstimateReport& r, const ReportFit& fit);
 std::string estimate_text(const EstimateReport& r, double dt_s, const ReportFit& fit);
+
+/// What `lash estimate --json` and Python's `Result.to_dict()` print for an estimate_auto run:
+/// estimate_json of its report, plus per side `guess` ({"value", "source": "given"|"searched",
+/// "edge_seen"}; `reason` "wrong_guess" when the guess lay inside the deadzone), `outliers` (samples
+/// of y the outlier gate replaced) and `preset`.
+std::string estimate_auto_json(const AutoRun& run, Preset preset, const ReportFit& fit);
+/// estimate_text plus a line per searched/given guess (or wrong_guess) and the outlier count.
+std::string estimate_auto_text(const AutoRun& run, double dt_s, const ReportFit& fit);
 
 }  // namespace lash
