@@ -140,7 +140,7 @@ Result estimate(const pyb::handle& t_obj, const pyb::handle& v_obj, const pyb::h
   const auto t = ta.span(), v = va.span(), y = ya.span();
   sample_period(t, "", {}, "t");  // checks t (strictly increasing, at least 3 samples)
   // as load_record: dt is the mean step without the gaps, and the estimator restarts at each gap
-  const Sampling smp = analyse_sampling(std::vector<double>(t.begin(), t.end()));
+  const Sampling smp = analyse_sampling(t);
   const double dt = smp.dt;
   const EstimateSettings set = configure(model, preset, dt, settings, v, y);
   std::optional<AutoRun> ar;

@@ -309,30 +309,29 @@ Table read_table(const std::filesystem::path& path, const TableOptions& options)
   return r.read(path);
 }
 
-Sampling analyse_sampling(const std::vector<double>& t, double gap_factor) {
+Sampling analyse_sampling(std::span<const double> t, double gap_factor) {
   Sampling s;
   if (t.size() < 2) return s;
+  // One scratch vector of the steps, reordered by nth_element; the pass below reads t itself.
   std::vector<double> d(t.size() - 1);
   for (std::size_t i = 1; i < t.size(); ++i) d[i - 1] = t[i] - t[i - 1];
-  std::vector<double> sorted = d;
-  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
-  double med = sorted[sorted.size() / 2];
-  if (sorted.size() % 2 == 0) {
-    const double lo = *std::max_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2));
-    med = 0.5 * (med + lo);
-  }
+  const auto mid = d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2);
+  std::nth_element(d.begin(), mid, d.end());
+  double med = *mid;
+  if (d.size() % 2 == 0) med = 0.5 * (med + *std::max_element(d.begin(), mid));
   s.median_dt = med;
   // dt = (span − the gap steps) / (steps − gaps): without gaps exactly (t.back() − t.front())/(n − 1).
   double gap_sum = 0.0;
-  for (std::size_t i = 0; i < d.size(); ++i) {
-    if (d[i] > gap_factor * med) {
-      s.gap_rows.push_back(i + 1);
-      gap_sum += d[i];
+  for (std::size_t i = 1; i < t.size(); ++i) {
+    const double step = t[i] - t[i - 1];
+    if (step > gap_factor * med) {
+      s.gap_rows.push_back(i);
+      gap_sum += step;
       continue;
     }
-    if (med > 0) s.max_jitter = std::max(s.max_jitter, std::abs(d[i] - med) / med);
+    if (med > 0) s.max_jitter = std::max(s.max_jitter, std::abs(step - med) / med);
   }
-  const std::size_t n = d.size() - s.gap_rows.size();
+  const std::size_t n = t.size() - 1 - s.gap_rows.size();
   s.dt = n ? (t.back() - t.front() - gap_sum) / static_cast<double>(n) : med;
   return s;
 }

@@ -9,20 +9,14 @@
 #include "lash/hil/bench_layout.hpp"
 #include "lash/hil/nodes.hpp"
 #include "lash/hil/simulate.hpp"
+#include "recorded_dto.hpp"
 
 using namespace lash;
 using namespace lash::hil;
 
 namespace {
 
-can::Frame recorded_dto() {
-  can::Frame f;
-  f.id = 0x7E1;
-  f.len = 8;
-  const std::uint8_t bytes[8] = {0xFF, 0x00, 0x00, 0x21, 0x07, 0x5A, 0x00, 0x03};
-  for (int i = 0; i < 8; ++i) f.data[static_cast<std::size_t>(i)] = bytes[i];
-  return f;
-}
+using test::recorded_dto;
 
 ControllerConfig controller(double dt_s) {
   ControllerConfig c;

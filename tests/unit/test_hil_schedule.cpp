@@ -12,20 +12,14 @@
 #include "lash/hil/report.hpp"
 #include "lash/hil/schedule.hpp"
 #include "lash/io/error.hpp"
+#include "recorded_dto.hpp"
 
 using namespace lash;
 using namespace lash::hil;
 
 namespace {
 
-can::Frame recorded_dto() {
-  can::Frame f;
-  f.id = 0x7E1;
-  f.len = 8;
-  const std::uint8_t bytes[8] = {0xFF, 0x00, 0x00, 0x21, 0x07, 0x5A, 0x00, 0x03};
-  for (int i = 0; i < 8; ++i) f.data[static_cast<std::size_t>(i)] = bytes[i];
-  return f;
-}
+using test::recorded_dto;
 
 constexpr double kT = 0.005;
 

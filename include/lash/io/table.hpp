@@ -24,6 +24,7 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <span>
 #include <vector>
 
 namespace lash {
@@ -67,6 +68,6 @@ struct Sampling {
   std::vector<std::size_t> gap_rows;   ///< rows i with t[i] − t[i−1] > kGapFactor·median_dt
 };
 /// Sampling of `t` (at least 2 samples). Steps above gap_factor·median are gaps.
-Sampling analyse_sampling(const std::vector<double>& t, double gap_factor = kGapFactor);
+Sampling analyse_sampling(std::span<const double> t, double gap_factor = kGapFactor);
 
 }  // namespace lash
