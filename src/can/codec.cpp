@@ -305,37 +305,44 @@ void MessageCodec::build_fast_plan() {
           std::all_of(lanes_.begin(), lanes_.end(), [](const Lane& l) { return l.half_tol > 0; });
   if (!fast_) return;
   fast_n_ = codecs_.size();
-  bool range = false, tie = false;
-  for (int group = 0; group < 4; ++group) {
-    const bool motorola = group >= 2, sgn = (group & 1) != 0;
-    for (const Lane& l : lanes_) {
-      const SignalCodec& c = codecs_[l.index];
-      if ((l.word == 1) != motorola || c.signed_ != sgn) continue;
-      FastLane f{};
-      f.factor = l.factor;
-      f.offset = l.offset;
-      f.inv_factor = l.inv_factor;
-      f.min_phys = l.min_phys;
-      f.max_phys = l.max_phys;
-      // gap < half_tol  <=>  gap <= tol, so that one min() over all lanes decides (>= 0).
-      f.tol = std::nextafter(l.half_tol, 0.0);
-      f.mask = l.mask;
-      f.above = ~l.mask;
-      f.bias = std::bit_cast<std::uint64_t>(kMagic) + static_cast<std::uint64_t>(l.raw_lo);
-      f.index = l.index;
-      f.lo = l.lo;
-      f.up = static_cast<std::uint8_t>(64 - l.lo - c.length_);
-      f.down = static_cast<std::uint8_t>(64 - c.length_);
-      range = range || c.has_range_;
-      // The product by the reciprocal is the quotient when the factor is a power of two.
-      int e = 0;
-      tie = tie || std::frexp(std::fabs(l.factor), &e) != 0.5;
-      fast_lanes_.push_back(f);
+  fast_lanes_.resize(fast_n_);
+  bool range = false, tie = false, intel = false, motorola = false;
+  fast_tol_ = std::numeric_limits<double>::infinity();
+  for (const Lane& l : lanes_) {
+    const SignalCodec& c = codecs_[l.index];
+    FastLane& f = fast_lanes_[l.index];
+    f.offset = l.offset;
+    f.inv_factor = l.inv_factor;
+    f.factor = l.factor;
+    f.min_phys = l.min_phys;
+    f.max_phys = l.max_phys;
+    f.bias = std::bit_cast<std::uint64_t>(kMagic) + static_cast<std::uint64_t>(l.raw_lo);
+    f.above = ~l.mask;
+    f.mask = l.mask;
+    f.keep = c.signed_ ? ~std::uint64_t{0} : l.mask;
+    f.sel = l.word == 1 ? ~std::uint64_t{0} : 0;
+    f.lo = l.lo;
+    f.up = static_cast<std::uint8_t>(64 - l.lo - c.length_);
+    f.down = static_cast<std::uint8_t>(64 - c.length_);
+    (l.word == 1 ? motorola : intel) = true;
+    range = range || c.has_range_;
+    // The product by the reciprocal is the quotient when the factor is a power of two:
+    // only the other lanes bound the message's tie tolerance. gap < half_tol <=> gap <= tol.
+    int e = 0;
+    if (std::frexp(std::fabs(l.factor), &e) != 0.5) {
+      tie = true;
+      fast_tol_ = std::min(fast_tol_, std::nextafter(l.half_tol, 0.0));
     }
-    fast_end_[group] = static_cast<std::uint32_t>(fast_lanes_.size());
   }
-  encode_fast_ = range ? (tie ? &encode_fast<true, true> : &encode_fast<true, false>)
-                       : (tie ? &encode_fast<false, true> : &encode_fast<false, false>);
+  const Order o = intel && motorola ? Order::mixed : motorola ? Order::motorola : Order::intel;
+  const auto pick = [&]<Order O>() {
+    decode_fast_ = &decode_fast<O>;
+    encode_fast_ = range ? (tie ? &encode_fast<O, true, true> : &encode_fast<O, true, false>)
+                         : (tie ? &encode_fast<O, false, true> : &encode_fast<O, false, false>);
+  };
+  if (o == Order::intel) pick.template operator()<Order::intel>();
+  else if (o == Order::motorola) pick.template operator()<Order::motorola>();
+  else pick.template operator()<Order::mixed>();
 }
 
 bool MessageCodec::selected(std::size_t i, std::span<const std::uint8_t> data, std::span<const double> values) const noexcept {
@@ -380,48 +387,62 @@ inline void store_le8(std::uint8_t* p, std::uint64_t w) noexcept {
 }
 }  // namespace
 
-void MessageCodec::decode_fast(const std::uint8_t* data, double* values) const noexcept {
+template <MessageCodec::Order O>
+void MessageCodec::decode_fast(const MessageCodec& m, const std::uint8_t* data, double* values) noexcept {
   const std::uint64_t le = load_le8(data);
   const std::uint64_t be = __builtin_bswap64(le);
-  const FastLane* const l = fast_lanes_.data();
-  const auto put = [values](const FastLane& f, std::int64_t raw) {
-    values[f.index] = static_cast<double>(raw) * f.factor + f.offset;
-  };
-  std::uint32_t k = 0;
-  for (; k < fast_end_[0]; ++k) put(l[k], static_cast<std::int64_t>((le >> l[k].lo) & l[k].mask));
-  for (; k < fast_end_[1]; ++k) put(l[k], static_cast<std::int64_t>(le << l[k].up) >> l[k].down);
-  for (; k < fast_end_[2]; ++k) put(l[k], static_cast<std::int64_t>((be >> l[k].lo) & l[k].mask));
-  for (; k < fast_end_[3]; ++k) put(l[k], static_cast<std::int64_t>(be << l[k].up) >> l[k].down);
+  const FastLane* const l = m.fast_lanes_.data();
+  const std::size_t n = m.fast_n_;
+  for (std::size_t i = 0; i < n; ++i) {
+    const FastLane& f = l[i];
+    std::uint64_t w;
+    if constexpr (O == Order::intel) w = le;
+    else if constexpr (O == Order::motorola) w = be;
+    else w = (le & ~f.sel) | (be & f.sel);
+    // The field at the top of the word, then down: arithmetic (sign-extends), and `keep`
+    // clears the extension of an unsigned field.
+    const auto raw = (static_cast<std::int64_t>(w << f.up) >> f.down) & static_cast<std::int64_t>(f.keep);
+    values[i] = static_cast<double>(raw) * f.factor + f.offset;
+  }
 }
 
-template <bool Range, bool Tie>
+template <MessageCodec::Order O, bool Range, bool Tie>
 bool MessageCodec::encode_fast(const MessageCodec& m, const double* values, std::uint8_t* data) noexcept {
   // Every lane without a branch, then one test: nothing is written, and encode() takes the
   // per-lane path (lane_raw(), SignalCodec::to_raw()), when a value is NaN or ±inf, outside
   // [min|max] (Range: some lane has one) or its field, or when the product by the
   // reciprocal lies within rounding error of a .5 tie (Tie: some factor is no power of two).
-  double margin = std::numeric_limits<double>::infinity();  // must end >= 0
+  double gap = 0.0;                                          // largest |q - round(q)|: must end <= fast_tol_
+  double inside = std::numeric_limits<double>::infinity();  // must end >= 0
   std::uint64_t bad = 0;                                     // must end 0
-  const auto lane = [&](const FastLane& f) {
-    const double p = values[f.index];
+  std::uint64_t s0 = 0, s1 = 0;                              // little- / big-endian word
+  const FastLane* const l = m.fast_lanes_.data();
+  const std::size_t n = m.fast_n_;
+  for (std::size_t i = 0; i < n; ++i) {
+    const FastLane& f = l[i];
+    const double p = values[i];
     const double q = (p - f.offset) * f.inv_factor;
     const double t = q + kMagic;
-    if constexpr (Tie) margin = std::min(margin, f.tol - std::fabs(q - (t - kMagic)));
+    if constexpr (Tie) gap = std::max(gap, std::fabs(q - (t - kMagic)));
     // p - min and max - p are >= 0 exactly when p is inside (IEEE subtraction keeps the sign).
-    if constexpr (Range) margin = std::min(margin, std::min(p - f.min_phys, f.max_phys - p));
+    if constexpr (Range) inside = std::min(inside, std::min(p - f.min_phys, f.max_phys - p));
     // bits(t) - bias = raw - smallest raw: in the field iff no bit above the mask. A |q| of
     // 2^51 or more, ±inf or NaN leaves bits far above any field of this path (≤ 49 bits).
     const auto b = std::bit_cast<std::uint64_t>(t);
     bad |= (b - f.bias) & f.above;
-    return (b & f.mask) << f.lo;  // bits(kMagic) has no bit below 51: the low bits are raw's
-  };
-  const FastLane* const l = m.fast_lanes_.data();
-  std::uint64_t s0 = 0, s1 = 0;
-  std::uint32_t k = 0;
-  for (; k < m.fast_end_[1]; ++k) s0 |= lane(l[k]);
-  for (; k < m.fast_end_[3]; ++k) s1 |= lane(l[k]);
-  if (bad != 0 || !(margin >= 0.0)) [[unlikely]] return false;
-  store_le8(data, (load_le8(data) & ~m.clear_le_) | s0 | __builtin_bswap64(s1));
+    const std::uint64_t v = (b & f.mask) << f.lo;  // bits(kMagic) has no bit below 51: the low bits are raw's
+    if constexpr (O == Order::intel) s0 |= v;
+    else if constexpr (O == Order::motorola) s1 |= v;
+    else {
+      s0 |= v & ~f.sel;
+      s1 |= v & f.sel;
+    }
+  }
+  if (bad != 0 || !(gap <= m.fast_tol_) || !(inside >= 0.0)) [[unlikely]] return false;
+  std::uint64_t w = load_le8(data) & ~m.clear_le_;
+  if constexpr (O != Order::motorola) w |= s0;
+  if constexpr (O != Order::intel) w |= __builtin_bswap64(s1);
+  store_le8(data, w);
   return true;
 }
 

@@ -135,7 +135,7 @@ class MessageCodec {
   /// False (values untouched) when a span is too short.
   bool decode(std::span<const std::uint8_t> data, std::span<double> values) const noexcept {
     if (fast_ && data.size() >= 8 && values.size() == fast_n_) [[likely]] {
-      decode_fast(data.data(), values.data());
+      decode_fast_(*this, data.data(), values.data());
       return true;
     }
     return decode_general(data, values);
@@ -191,32 +191,38 @@ class MessageCodec {
   std::uint64_t clear_all_[2] = {0, 0};  ///< bits of every signal per word (messages without multiplexing)
   /// The fast path (a plan built at construction): a packed message without multiplexing
   /// whose signals are all integer lanes of at most 48 bits (49 signed), coded from/into a
-  /// span of at least 8 bytes with one load and one store. Decoding: each lane is a shift
-  /// and a mask (unsigned) or an arithmetic shift pair (signed) of the little- or big-endian
-  /// word, in four groups (no per-lane flag), scaled. Encoding: every lane without a branch,
-  /// and one test per message (see encode_fast()); on any doubt the per-lane path decides.
+  /// span of at least 8 bytes with one load and one store. One lane per signal, in layout
+  /// order (values[i] is lane i, no index). Decoding: each lane is (word << up) >> down
+  /// (arithmetic) & keep of the little- or big-endian word, scaled. Encoding: every lane
+  /// without a branch, and one test per message (see encode_fast()); on any doubt the
+  /// per-lane path decides. The byte order (all Intel, all Motorola, mixed), the range and
+  /// the tie test are template parameters chosen at construction.
   struct FastLane {
-    double factor, offset, inv_factor, min_phys, max_phys;
-    double tol;            ///< largest |q - round(q)| that cannot hide a tie (see lane_raw); < 0: none
-    std::uint64_t mask;    ///< low `length` bits
-    std::uint64_t above;   ///< ~mask
+    double offset, inv_factor, factor, min_phys, max_phys;
     std::uint64_t bias;    ///< bits of kMagic + smallest raw (see encode_fast)
-    std::uint32_t index;   ///< signal index
+    std::uint64_t above;   ///< ~mask: bits that must stay clear in bits(t) - bias
+    std::uint64_t mask;    ///< low `length` bits
+    std::uint64_t keep;    ///< decode: mask for unsigned lanes, all ones for signed ones
+    std::uint64_t sel;     ///< mixed byte orders: all ones for a Motorola lane, else 0
     std::uint8_t lo;       ///< LSB position in the word
-    std::uint8_t up, down; ///< decode of a signed lane: (word << up) >> down, arithmetic
+    std::uint8_t up, down; ///< decode: (word << up) >> down, arithmetic
   };
+  enum class Order : std::uint8_t { intel, motorola, mixed };
   using EncodeFastFn = bool (*)(const MessageCodec&, const double*, std::uint8_t*) noexcept;
-  template <bool Range, bool Tie>
+  using DecodeFastFn = void (*)(const MessageCodec&, const std::uint8_t*, double*) noexcept;
+  template <Order O, bool Range, bool Tie>
   static bool encode_fast(const MessageCodec& m, const double* values, std::uint8_t* data) noexcept;
+  template <Order O>
+  static void decode_fast(const MessageCodec& m, const std::uint8_t* data, double* values) noexcept;
   void build_fast_plan();
-  void decode_fast(const std::uint8_t* data, double* values) const noexcept;
   bool decode_general(std::span<const std::uint8_t> data, std::span<double> values) const noexcept;
   EncodeResult encode_general(std::span<const double> values, std::span<std::uint8_t> data) noexcept;
   bool fast_ = false;
-  std::size_t fast_n_ = 0;          ///< signal count (the fast path's values size)
-  std::vector<FastLane> fast_lanes_;  ///< Intel unsigned, Intel signed, Motorola unsigned, Motorola signed
-  std::uint32_t fast_end_[4] = {0, 0, 0, 0};  ///< end of each group in fast_lanes_
+  std::size_t fast_n_ = 0;            ///< signal count (the fast path's values size)
+  std::vector<FastLane> fast_lanes_;  ///< one per signal, layout order
+  double fast_tol_ = 0.0;  ///< largest |q - round(q)| that cannot hide a tie, over the lanes that need the test
   EncodeFastFn encode_fast_ = nullptr;
+  DecodeFastFn decode_fast_ = nullptr;
   std::uint64_t clear_le_ = 0;  ///< every signal's bits in the little-endian word
   /// Multiplexing: signal i is present when its multiplexor parent_[i] is present and
   /// holds a raw value in ranges_[range_begin_[i] .. range_begin_[i + 1]).
