@@ -14,6 +14,7 @@
 #include <cstring>
 #include <limits>
 #include <stdexcept>
+#include <utility>
 
 #include <fmt/core.h>
 
@@ -313,17 +314,25 @@ void MessageCodec::build_fast_plan() {
     FastLane& f = fast_lanes_[l.index];
     f.offset = l.offset;
     f.inv_factor = l.inv_factor;
-    f.factor = l.factor;
     f.min_phys = l.min_phys;
     f.max_phys = l.max_phys;
     f.bias = std::bit_cast<std::uint64_t>(kMagic) + static_cast<std::uint64_t>(l.raw_lo);
     f.above = ~l.mask;
     f.mask = l.mask;
-    f.keep = c.signed_ ? ~std::uint64_t{0} : l.mask;
+    f.place = std::uint64_t{1} << l.lo;
+    // Decode: an unsigned field rotated to bit 0, a signed one to the top (bits 64-len..63)
+    // so that the int64 is raw × 2^k with the field's sign; scale = factor × 2^-k makes
+    // (raw × 2^k) × scale the same real number as raw × factor, hence the same double,
+    // as long as scale is a normal number (checked: else no fast plan).
+    const int k = c.signed_ ? 64 - static_cast<int>(c.length_) : 0;
+    f.rot = static_cast<std::uint8_t>((k - l.lo + 64) % 64);
+    f.field = l.mask << k;
+    f.scale = std::ldexp(l.factor, -k);
+    if (std::fpclassify(f.scale) != FP_NORMAL || std::ldexp(f.scale, k) != l.factor) {
+      fast_ = false;
+      return;
+    }
     f.sel = l.word == 1 ? ~std::uint64_t{0} : 0;
-    f.lo = l.lo;
-    f.up = static_cast<std::uint8_t>(64 - l.lo - c.length_);
-    f.down = static_cast<std::uint8_t>(64 - c.length_);
     (l.word == 1 ? motorola : intel) = true;
     range = range || c.has_range_;
     // The product by the reciprocal is the quotient when the factor is a power of two:
@@ -334,15 +343,28 @@ void MessageCodec::build_fast_plan() {
       fast_tol_ = std::min(fast_tol_, std::nextafter(l.half_tol, 0.0));
     }
   }
-  const Order o = intel && motorola ? Order::mixed : motorola ? Order::motorola : Order::intel;
-  const auto pick = [&]<Order O>() {
-    decode_fast_ = &decode_fast<O>;
-    encode_fast_ = range ? (tie ? &encode_fast<O, true, true> : &encode_fast<O, true, false>)
-                         : (tie ? &encode_fast<O, false, true> : &encode_fast<O, false, false>);
+  // One kernel per byte order, range/tie test and lane count (0: any count, a loop).
+  const std::size_t n = fast_n_ <= kUnrolled ? fast_n_ : 0;
+  const auto pick = [&]<Order O, std::size_t... N>(std::index_sequence<N...>) {
+    const DecodeFastFn dec[] = {&decode_fast<O, N>...};
+    const EncodeFastFn enc[4][sizeof...(N)] = {{&encode_fast<O, false, false, N>...},
+                                               {&encode_fast<O, false, true, N>...},
+                                               {&encode_fast<O, true, false, N>...},
+                                               {&encode_fast<O, true, true, N>...}};
+    decode_fast_ = dec[n];
+    encode_fast_ = enc[(range ? 2 : 0) + (tie ? 1 : 0)][n];
   };
-  if (o == Order::intel) pick.template operator()<Order::intel>();
-  else if (o == Order::motorola) pick.template operator()<Order::motorola>();
-  else pick.template operator()<Order::mixed>();
+  const auto counts = std::make_index_sequence<kUnrolled + 1>();
+  if (intel && motorola) {
+    // Mixed byte orders are rare: one loop kernel.
+    decode_fast_ = &decode_fast<Order::mixed, 0>;
+    encode_fast_ = range ? (tie ? &encode_fast<Order::mixed, true, true, 0> : &encode_fast<Order::mixed, true, false, 0>)
+                         : (tie ? &encode_fast<Order::mixed, false, true, 0> : &encode_fast<Order::mixed, false, false, 0>);
+  } else if (motorola) {
+    pick.template operator()<Order::motorola>(counts);
+  } else {
+    pick.template operator()<Order::intel>(counts);
+  }
 }
 
 bool MessageCodec::selected(std::size_t i, std::span<const std::uint8_t> data, std::span<const double> values) const noexcept {
@@ -387,26 +409,25 @@ inline void store_le8(std::uint8_t* p, std::uint64_t w) noexcept {
 }
 }  // namespace
 
-template <MessageCodec::Order O>
+template <MessageCodec::Order O, std::size_t N>
 void MessageCodec::decode_fast(const MessageCodec& m, const std::uint8_t* data, double* values) noexcept {
   const std::uint64_t le = load_le8(data);
   const std::uint64_t be = __builtin_bswap64(le);
   const FastLane* const l = m.fast_lanes_.data();
-  const std::size_t n = m.fast_n_;
+  const std::size_t n = N != 0 ? N : m.fast_n_;
+#pragma GCC unroll 8
   for (std::size_t i = 0; i < n; ++i) {
     const FastLane& f = l[i];
     std::uint64_t w;
     if constexpr (O == Order::intel) w = le;
     else if constexpr (O == Order::motorola) w = be;
     else w = (le & ~f.sel) | (be & f.sel);
-    // The field at the top of the word, then down: arithmetic (sign-extends), and `keep`
-    // clears the extension of an unsigned field.
-    const auto raw = (static_cast<std::int64_t>(w << f.up) >> f.down) & static_cast<std::int64_t>(f.keep);
-    values[i] = static_cast<double>(raw) * f.factor + f.offset;
+    const auto x = static_cast<std::int64_t>(std::rotl(w, f.rot) & f.field);  // raw × 2^k
+    values[i] = static_cast<double>(x) * f.scale + f.offset;
   }
 }
 
-template <MessageCodec::Order O, bool Range, bool Tie>
+template <MessageCodec::Order O, bool Range, bool Tie, std::size_t N>
 bool MessageCodec::encode_fast(const MessageCodec& m, const double* values, std::uint8_t* data) noexcept {
   // Every lane without a branch, then one test: nothing is written, and encode() takes the
   // per-lane path (lane_raw(), SignalCodec::to_raw()), when a value is NaN or ±inf, outside
@@ -417,7 +438,8 @@ bool MessageCodec::encode_fast(const MessageCodec& m, const double* values, std:
   std::uint64_t bad = 0;                                     // must end 0
   std::uint64_t s0 = 0, s1 = 0;                              // little- / big-endian word
   const FastLane* const l = m.fast_lanes_.data();
-  const std::size_t n = m.fast_n_;
+  const std::size_t n = N != 0 ? N : m.fast_n_;
+#pragma GCC unroll 8
   for (std::size_t i = 0; i < n; ++i) {
     const FastLane& f = l[i];
     const double p = values[i];
@@ -430,7 +452,8 @@ bool MessageCodec::encode_fast(const MessageCodec& m, const double* values, std:
     // 2^51 or more, ±inf or NaN leaves bits far above any field of this path (≤ 49 bits).
     const auto b = std::bit_cast<std::uint64_t>(t);
     bad |= (b - f.bias) & f.above;
-    const std::uint64_t v = (b & f.mask) << f.lo;  // bits(kMagic) has no bit below 51: the low bits are raw's
+    // bits(kMagic) has no bit below 51: the low bits are raw's; × 2^lo puts them in place.
+    const std::uint64_t v = (b & f.mask) * f.place;
     if constexpr (O == Order::intel) s0 |= v;
     else if constexpr (O == Order::motorola) s1 |= v;
     else {

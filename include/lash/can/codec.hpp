@@ -192,27 +192,32 @@ class MessageCodec {
   /// The fast path (a plan built at construction): a packed message without multiplexing
   /// whose signals are all integer lanes of at most 48 bits (49 signed), coded from/into a
   /// span of at least 8 bytes with one load and one store. One lane per signal, in layout
-  /// order (values[i] is lane i, no index). Decoding: each lane is (word << up) >> down
-  /// (arithmetic) & keep of the little- or big-endian word, scaled. Encoding: every lane
-  /// without a branch, and one test per message (see encode_fast()); on any doubt the
-  /// per-lane path decides. The byte order (all Intel, all Motorola, mixed), the range and
-  /// the tie test are template parameters chosen at construction.
+  /// order (values[i] is lane i, no index). Decoding: each lane is a rotation and a mask
+  /// of the little- or big-endian word (unsigned fields rotated to bit 0, signed ones to
+  /// the top, so that the int64 carries the sign), times factor × 2^-position (exact), plus
+  /// offset. Encoding: every lane without a branch, and one test per message (see
+  /// encode_fast()); on any doubt the per-lane path decides. The byte order (all Intel, all
+  /// Motorola, mixed), the range and tie tests and the lane count (up to kUnrolled) are
+  /// template parameters chosen at construction.
   struct FastLane {
-    double offset, inv_factor, factor, min_phys, max_phys;
+    double offset, inv_factor, min_phys, max_phys;
+    double scale;          ///< decode: factor × 2^-k, k the field's position after the rotation (exact)
     std::uint64_t bias;    ///< bits of kMagic + smallest raw (see encode_fast)
     std::uint64_t above;   ///< ~mask: bits that must stay clear in bits(t) - bias
     std::uint64_t mask;    ///< low `length` bits
-    std::uint64_t keep;    ///< decode: mask for unsigned lanes, all ones for signed ones
+    std::uint64_t place;   ///< encode: 2^lo (the field's bits times place = the bits in the word)
+    std::uint64_t field;   ///< decode: the field's bits after the rotation (at 0 unsigned, at the top signed)
     std::uint64_t sel;     ///< mixed byte orders: all ones for a Motorola lane, else 0
-    std::uint8_t lo;       ///< LSB position in the word
-    std::uint8_t up, down; ///< decode: (word << up) >> down, arithmetic
+    std::uint8_t rot;      ///< decode: left rotation of the word
   };
   enum class Order : std::uint8_t { intel, motorola, mixed };
+  /// Lane counts up to this have their own (fully unrolled) kernels; more take a loop.
+  static constexpr std::size_t kUnrolled = 8;
   using EncodeFastFn = bool (*)(const MessageCodec&, const double*, std::uint8_t*) noexcept;
   using DecodeFastFn = void (*)(const MessageCodec&, const std::uint8_t*, double*) noexcept;
-  template <Order O, bool Range, bool Tie>
+  template <Order O, bool Range, bool Tie, std::size_t N>
   static bool encode_fast(const MessageCodec& m, const double* values, std::uint8_t* data) noexcept;
-  template <Order O>
+  template <Order O, std::size_t N>
   static void decode_fast(const MessageCodec& m, const std::uint8_t* data, double* values) noexcept;
   void build_fast_plan();
   bool decode_general(std::span<const std::uint8_t> data, std::span<double> values) const noexcept;
