@@ -210,6 +210,12 @@ class MessageCodec {
     std::uint64_t sel;     ///< mixed byte orders: all ones for a Motorola lane, else 0
     std::uint8_t rot;      ///< decode: left rotation of the word
   };
+  /// Two consecutive lanes of an Intel-only or Motorola-only plan, for encode_fast's
+  /// two-wide (SSE2) arithmetic: lanes 2j and 2j+1 side by side.
+  struct alignas(16) FastPair {
+    double offset[2], inv_factor[2], min_phys[2], max_phys[2];
+    std::uint64_t bias[2], above[2], mask[2], place[2];
+  };
   enum class Order : std::uint8_t { intel, motorola, mixed };
   /// Lane counts up to this have their own (fully unrolled) kernels; more take a loop.
   static constexpr std::size_t kUnrolled = 8;
@@ -225,6 +231,7 @@ class MessageCodec {
   bool fast_ = false;
   std::size_t fast_n_ = 0;            ///< signal count (the fast path's values size)
   std::vector<FastLane> fast_lanes_;  ///< one per signal, layout order
+  std::vector<FastPair> fast_pairs_;  ///< lanes 2j, 2j+1 (a last odd lane is only in fast_lanes_)
   double fast_tol_ = 0.0;  ///< largest |q - round(q)| that cannot hide a tie, over the lanes that need the test
   EncodeFastFn encode_fast_ = nullptr;
   DecodeFastFn decode_fast_ = nullptr;
