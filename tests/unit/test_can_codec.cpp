@@ -235,21 +235,32 @@ TEST(CanCodec, MessagePathMatchesSignalPath) {
   // MessageCodec's one-word path (messages <= 8 bytes) against SignalCodec one signal at a
   // time, on random messages of non-overlapping signals and random (also out-of-range) values.
   lash::Rng rng(99);
-  const double factors[] = {0.1, 0.5, 1.0, 2.5, 0.01, -0.25, 1e-3};
+  // 1e-300: a signed field's decode scale (factor x 2^-k) would be subnormal, so no fast plan.
+  const double factors[] = {0.1, 0.5, 1.0, 2.5, 0.01, -0.25, 1e-3, 7.0, 1e-300};
+  // Messages of 1..12 signals: the fast plan has kernels for 1..8 lanes and a loop beyond.
+  std::vector<int> seen(13, 0), fits(13, 0);
   for (int n = 0; n < 20000; ++n) {
     dbc::Message m;
     m.name = "R";
     m.size = static_cast<std::uint32_t>(1 + rng.next() % 8);
     std::vector<bool> used(64, false);
-    const int want = 1 + static_cast<int>(rng.next() % 6);
-    for (int k = 0; k < want * 4 && static_cast<int>(m.signals.size()) < want; ++k) {
-      const auto len = static_cast<std::uint32_t>(1 + rng.next() % std::min<std::uint32_t>(64, m.size * 8));
+    const int want = 1 + static_cast<int>(rng.next() % 12);
+    const std::uint32_t max_len = want > 6 ? 8 : 64;
+    // Mostly one byte order per message (the fast plan's two-wide kernels), sometimes mixed.
+    const bool mixed = rng.next() % 4 == 0;
+    const bool intel = (rng.next() & 1) != 0;
+    // Half the messages get values inside every field (and [min|max] wide enough), the case
+    // the fast plan codes by itself; the other half also values to clamp (the fallback).
+    const bool fit = (rng.next() & 1) != 0;
+    for (int k = 0; k < want * 8 && static_cast<int>(m.signals.size()) < want; ++k) {
+      const auto len = static_cast<std::uint32_t>(1 + rng.next() % std::min<std::uint32_t>(max_len, m.size * 8));
+      const bool in = mixed ? (rng.next() & 1) != 0 : intel;
       auto s = make(static_cast<std::uint32_t>(rng.next() % (m.size * 8)), len,
-                    (rng.next() & 1) ? ByteOrder::intel : ByteOrder::motorola, (rng.next() & 1) != 0,
-                    factors[rng.next() % 7], static_cast<double>(static_cast<int>(rng.next() % 200) - 100));
+                    in ? ByteOrder::intel : ByteOrder::motorola, (rng.next() & 1) != 0,
+                    factors[rng.next() % 9], static_cast<double>(static_cast<int>(rng.next() % 200) - 100));
       if (rng.next() % 3 == 0) {
-        s.minimum = -50;
-        s.maximum = 50;
+        s.minimum = fit ? -1e12 : -50;
+        s.maximum = fit ? 1e12 : 50;
       }
       if (s.byte_order == ByteOrder::intel && s.start_bit + len > m.size * 8) continue;
       if (naive_min_bytes(s) > m.size) continue;
@@ -263,12 +274,25 @@ TEST(CanCodec, MessagePathMatchesSignalPath) {
     }
     MessageCodec mc(m);
     ASSERT_TRUE(mc.packed());
+    ++seen[m.signals.size()];
     std::vector<SignalCodec> sc;
     for (const auto& s : m.signals) sc.emplace_back(s);
     std::vector<double> vals(m.signals.size());
-    for (auto& v : vals) {
-      const double u = static_cast<double>(rng.next() % 2000001) / 1000.0 - 1000.0;  // -1000..1000, step 0.001
-      v = (rng.next() % 5 == 0) ? std::round(u) + 0.5 : u;  // some exact ties
+    for (std::size_t i = 0; i < vals.size(); ++i) {
+      const dbc::Signal& s = m.signals[i];
+      if (fit) {
+        // A raw value of the field, ± up to 0.4, or + 0.5 (a tie, up to the rounding of the
+        // scaling), in physical units.
+        const std::uint64_t mask = s.length == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << s.length) - 1;
+        std::uint64_t u = rng.next() & mask;
+        if (s.is_signed && s.length < 64 && (u >> (s.length - 1)) != 0) u |= ~mask;
+        const double raw = s.is_signed ? static_cast<double>(static_cast<std::int64_t>(u)) : static_cast<double>(u);
+        const double frac = (rng.next() % 5 == 0) ? 0.5 : static_cast<double>(static_cast<int>(rng.next() % 801) - 400) / 1000.0;
+        vals[i] = (raw + frac) * s.factor + s.offset;
+      } else {
+        const double u = static_cast<double>(rng.next() % 2000001) / 1000.0 - 1000.0;  // -1000..1000, step 0.001
+        vals[i] = (rng.next() % 5 == 0) ? std::round(u) + 0.5 : u;  // some exact ties
+      }
     }
     std::vector<std::uint8_t> a(8), b(8);
     for (std::size_t i = 0; i < 8; ++i) a[i] = b[i] = static_cast<std::uint8_t>(rng.next());
@@ -280,8 +304,13 @@ TEST(CanCodec, MessagePathMatchesSignalPath) {
       clamps += sc[i].encode(vals[i], {b.data(), span}) == SignalCodec::Status::clamped ? 1u : 0u;
     ASSERT_EQ(a, b) << "message " << n;
     ASSERT_EQ(r.clamped, clamps);
+    fits[m.signals.size()] += clamps == 0 ? 1 : 0;
     std::vector<double> out(vals.size());
     ASSERT_TRUE(mc.decode({a.data(), span}, out));
     for (std::size_t i = 0; i < sc.size(); ++i) ASSERT_EQ(out[i], *sc[i].decode({a.data(), span})) << n;
+  }
+  for (std::size_t k = 1; k <= 12; ++k) {
+    EXPECT_GE(seen[k], 100) << k << " signals";
+    EXPECT_GE(fits[k], 50) << k << " signals, no clamp";
   }
 }
