@@ -323,6 +323,47 @@ double median_step_full(std::span<const double> t) {
   return med;
 }
 
+/// Counts of steps against a bracket [lo, hi] of the median (median_step).
+struct StepCounts {
+  std::size_t below = 0, at_lo = 0, at_hi = 0, above = 0;
+};
+
+/// Counts the steps t[i] − t[i−1] from row i on into `c` until one lies strictly inside (lo, hi);
+/// returns its row (t.size() when none). Not inlined: a loop that calls nothing keeps its counters
+/// in registers, where the caller's loop (which appends to a vector) kept them in memory.
+[[gnu::noinline]] std::size_t count_steps(std::span<const double> t, std::size_t i, double lo, double hi,
+                                          StepCounts& c) noexcept {
+  std::size_t below = 0, at_lo = 0, at_hi = 0, above = 0;
+  const std::size_t hi_apart = lo < hi ? 1 : 0;  // lo == hi: a step equal to both counts once
+  for (; i < t.size(); ++i) {
+    const double d = t[i] - t[i - 1];
+    if (d > lo && d < hi) break;
+    below += d < lo ? 1 : 0;
+    at_lo += d == lo ? 1 : 0;
+    above += d > hi ? 1 : 0;
+    at_hi += d == hi ? hi_apart : 0;
+  }
+  c.below += below;
+  c.at_lo += at_lo;
+  c.at_hi += at_hi;
+  c.above += above;
+  return i;
+}
+
+/// From row i on: the largest |step − med| of the steps up to the first one above gap_above, into
+/// max_dev; returns that step's row (t.size() when none). Not inlined, as count_steps.
+[[gnu::noinline]] std::size_t scan_to_gap(std::span<const double> t, std::size_t i, double gap_above, double med,
+                                          double& max_dev) noexcept {
+  double m = max_dev;
+  for (; i < t.size(); ++i) {
+    const double step = t[i] - t[i - 1];
+    if (step > gap_above) break;
+    m = std::max(m, std::abs(step - med));
+  }
+  max_dev = m;
+  return i;
+}
+
 /// The same median, exactly, without sorting all the steps (Floyd & Rivest's selection): the
 /// median of a strided sample of the steps brackets the true one between two sample values lo ≤ hi;
 /// one pass counts the steps below lo, equal to lo, equal to hi and above hi and keeps only those
@@ -341,16 +382,13 @@ double median_step(std::span<const double> t) {
   // ±3 standard deviations of the sample median's rank (√kSample / 2 ≈ 23 positions)
   constexpr std::size_t kMargin = 96;
   const double lo = smp[kSample / 2 - kMargin], hi = smp[kSample / 2 + kMargin];
-  std::size_t below = 0, at_lo = 0, at_hi = 0, above = 0;
+  StepCounts c;
   std::vector<double> inside;
   for (std::size_t i = 1; i <= n; ++i) {
-    const double d = t[i] - t[i - 1];
-    if (d < lo) ++below;
-    else if (d == lo) ++at_lo;
-    else if (d > hi) ++above;
-    else if (d == hi) ++at_hi;
-    else if (d > lo && d < hi) inside.push_back(d);
+    i = count_steps(t, i, lo, hi, c);
+    if (i <= n) inside.push_back(t[i] - t[i - 1]);
   }
+  const std::size_t below = c.below, at_lo = c.at_lo, at_hi = c.at_hi, above = c.above;
   if (below + at_lo + inside.size() + at_hi + above != n) return median_step_full(t);  // a NaN step
   // the value of rank r (0-based) of all the steps; NaN when r lies outside [lo, hi]
   const auto rank = [&](std::size_t r) {
@@ -385,13 +423,10 @@ Sampling analyse_sampling(std::span<const double> t, double gap_factor) {
   double gap_sum = 0.0, max_dev = 0.0;
   const double gap_above = gap_factor * med;
   for (std::size_t i = 1; i < t.size(); ++i) {
-    const double step = t[i] - t[i - 1];
-    if (step > gap_above) {
-      s.gap_rows.push_back(i);
-      gap_sum += step;
-      continue;
-    }
-    max_dev = std::max(max_dev, std::abs(step - med));
+    i = scan_to_gap(t, i, gap_above, med, max_dev);
+    if (i == t.size()) break;
+    s.gap_rows.push_back(i);
+    gap_sum += t[i] - t[i - 1];
   }
   if (med > 0) s.max_jitter = max_dev / med;
   const std::size_t n = t.size() - 1 - s.gap_rows.size();
