@@ -78,10 +78,15 @@ class Estimator {
   }
 
   Result result(bool intervals) const {
-    EstimationRun run;
-    run.report = est_->report();
-    if (intervals) add_intervals(run, cfg_, v_, y_);
-    return Result(score_estimate(run.report, cfg_.dt_s, job_, t_, y_, ysim_));
+    std::optional<EstimateResult> res;
+    {
+      pyb::gil_scoped_release nogil;  // the intervals run the estimator once more over the samples
+      EstimationRun run;
+      run.report = est_->report();
+      if (intervals) add_intervals(run, cfg_, v_, y_);
+      res.emplace(score_estimate(run.report, cfg_.dt_s, job_, t_, y_, ysim_));
+    }
+    return Result(std::move(*res));
   }
 
   void reset() {
@@ -161,7 +166,12 @@ Result estimate(const pyb::handle& t_obj, const pyb::handle& v_obj, const pyb::h
 }
 
 pyb::dict read_record(const std::string& path, const std::vector<std::string>& columns) {
-  Record rec = load_record(path, columns);
+  std::optional<Record> loaded;
+  {
+    pyb::gil_scoped_release nogil;  // reading and parsing the file touches no Python object
+    loaded.emplace(load_record(path, columns));
+  }
+  Record& rec = *loaded;
   pyb::dict d;
   d["file"] = rec.data.file;
   d["dt_s"] = rec.dt_s;
