@@ -15,6 +15,8 @@
 #include <cmath>
 #include <vector>
 
+#include "e1_plant.hpp"
+
 #include "lash/identify/config_sources.hpp"
 #include "lash/identify/estimate.hpp"
 #include "lash/identify/estimators.hpp"
@@ -33,11 +35,7 @@ struct Arrays {
 const Arrays& arrays() {
   static const Arrays a = [] {
     using namespace lash;
-    std::vector<Block> b;
-    b.emplace_back(Deadzone({-300.0, 200.0}));
-    b.emplace_back(FirstOrder({{-0.96, 0.1}, {-0.94, 0.15}}));
-    b.emplace_back(Deadband({30.0, 50.0}));
-    Plant p(std::move(b), 0.005);
+    Plant p = bench::e1_plant();
     std::vector<double> v(kSamples);
     for (std::size_t k = 0; k < kSamples; ++k) v[k] = 600.0 * std::sin(0.005 * static_cast<double>(k));
     SimulationTrace tr = simulate(p, v, 0.0, 1);
