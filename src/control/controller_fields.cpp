@@ -319,9 +319,11 @@ std::string controller_keys_markdown() {
     std::string accepted = controller_field_is_name(f) ? "a name" : range_text(f).substr(std::strlen("must be "));
     if (const auto p = accepted.find(" ["); p != std::string::npos) accepted.resize(p);
     const std::string def = f.required ? "required" : controller_field_toml_value(f, defaults);
+    std::string doc = f.doc;  // a '|' inside a cell is escaped
+    for (std::size_t p = doc.find('|'); p != std::string::npos; p = doc.find('|', p + 2)) doc.insert(p, "\\");
     s += fmt::format("| `{}.{}` | {} | {} | {} | {} | {} | {} |\n", f.table, f.key, old.empty() ? "—" : old,
                      *f.flag != '\0' ? fmt::format("`--{}`", f.flag) : "—", *f.unit != '\0' ? f.unit : "—", accepted,
-                     def, f.doc);
+                     def, doc);
   }
   return s;
 }
