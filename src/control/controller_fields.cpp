@@ -1,12 +1,12 @@
 #include "lash/control/controller_fields.hpp"
 
-#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <limits>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include <fmt/core.h>
 
@@ -77,9 +77,9 @@ std::size_t index_of(std::string_view table, std::string_view key) {
 
 bool in_range(const ControllerField& f, double v) { return f.lo_open ? v > f.lo : v >= f.lo; }
 
-std::string range_text(const ControllerField& f) {
+std::string range_text(const ControllerField& f, bool with_unit = true) {
   std::string s = f.lo == kAny ? "must be a finite number" : fmt::format("must be {} {}", f.lo_open ? ">" : ">=", f.lo);
-  if (*f.unit != '\0') s += fmt::format(" [{}]", f.unit);
+  if (with_unit && *f.unit != '\0') s += fmt::format(" [{}]", f.unit);
   return s;
 }
 
@@ -89,15 +89,6 @@ AntiWindup parse_anti_windup(std::string_view s) {
   throw std::invalid_argument("must be \"none\" or \"clamp\"");
 }
 const char* to_text(AntiWindup a) { return a == AntiWindup::clamp ? "clamp" : "none"; }
-
-double parse_number(std::string_view s) {
-  double x = 0.0;
-  const auto* end = s.data() + s.size();
-  const auto r = std::from_chars(s.data(), end, x);
-  if (s.empty() || r.ec != std::errc() || r.ptr != end || !std::isfinite(x))
-    throw std::invalid_argument("expected a finite number, got '" + std::string(s) + "'");
-  return x;
-}
 
 /// Where a setting may be written: its canonical key, and the deprecated spellings of
 /// earlier releases (accepted for one release, with a warning).
@@ -129,10 +120,12 @@ const Spelling* pick(const std::vector<Spelling>& s, const std::string& canonica
 }
 
 /// Reads the value of `f` at `t`.`key` into `c` (input-only fields into `input`).
-void read_value(TomlTable& t, const std::string& key, const ControllerField& f, ControllerConfig& c, double& input) {
+/// `with_unit`: name the gains file's unit in a range error (not in a scenario, whose units vary).
+void read_value(TomlTable& t, const std::string& key, const ControllerField& f, ControllerConfig& c, double& input,
+                bool with_unit) {
   auto number = [&] {
     const double v = t.number(key);
-    if (!in_range(f, v)) t.fail(key, range_text(f));
+    if (!in_range(f, v)) t.fail(key, range_text(f, with_unit));
     return v;
   };
   auto named = [&](auto parse) {
@@ -174,7 +167,8 @@ bool controller_field_is_name(const ControllerField& f) noexcept {
 
 void parse_controller_field(const ControllerField& f, std::string_view text, ControllerConfig& c) {
   auto number = [&] {
-    const double v = parse_number(text);
+    double v = 0.0;
+    if (!parse_double(text, v)) throw std::invalid_argument("expected a finite number, got '" + std::string(text) + "'");
     if (!in_range(f, v)) throw std::invalid_argument(range_text(f) + ", got '" + std::string(text) + "'");
     return v;
   };
@@ -201,6 +195,50 @@ std::string controller_field_toml_value(const ControllerField& f, const Controll
                     f.at(const_cast<ControllerConfig&>(c)));  // at() only takes the member's address
 }
 
+namespace {
+
+/// Reads the rows of one table of the field table: each from its one spelling present in `T`
+/// (canonical key or alias) or `F` (the flat 0.1 key), into `c` (input-only rows into `input`);
+/// `given` records where each was found.
+struct RowReader {
+  const ControllerWarn& warn;
+  bool with_unit;
+  std::string prefix;  ///< dotted path of the controller table ("controller"), "" at the top
+  ControllerConfig& c;
+  double input[kN];
+  const Spelling* given[kN] = {};
+  std::vector<Spelling> spellings[kN];
+
+  RowReader(const ControllerWarn& w, bool u, std::string p, ControllerConfig& cfg)
+      : warn(w), with_unit(u), prefix(std::move(p)), c(cfg) {
+    for (std::size_t i = 0; i < kN; ++i) input[i] = kFields[i].input_default;
+  }
+  void read(std::string_view table, TomlTable* T, TomlTable* F, bool require, std::string_view skip = {}) {
+    for (std::size_t i = 0; i < kN; ++i) {
+      const ControllerField& f = kFields[i];
+      if (f.table != table || f.key == skip) continue;
+      auto& s = spellings[i];
+      s.push_back({T, f.key, false});
+      if (*f.alias != '\0') s.push_back({T, f.alias, true});
+      if (*f.flat != '\0') s.push_back({F, f.flat, true});
+      // The canonical name: controller.pid.ki_per_s; inline (a scenario's [controller]): controller.ki_per_s.
+      const std::string where = T != nullptr ? T->path(f.key) : (prefix.empty() ? "" : prefix + ".") + f.table + "." + f.key;
+      given[i] = pick(s, where, warn);
+      if (given[i] == nullptr) {
+        if (require && f.required && T != nullptr) T->number(f.key);  // throws: missing key, named in its table
+        continue;
+      }
+      read_value(*given[i]->table, given[i]->key, f, c, input[i], with_unit);
+    }
+  }
+};
+
+void check_output_limits(const PidConfig& pid, TomlTable* T) {
+  if (T != nullptr && !(pid.output_min <= pid.output_max)) T->fail("output_max", "needs output_min <= output_max");
+}
+
+}  // namespace
+
 ControllerConfig read_controller_config(TomlTable& top, const ControllerWarn& warn) {
   bool flat = false;
   for (const auto& f : kFields) flat = flat || (*f.flat != '\0' && top.has(f.flat));
@@ -208,40 +246,21 @@ ControllerConfig read_controller_config(TomlTable& top, const ControllerWarn& wa
   for (std::size_t k = 0; k < std::size(kTables); ++k) tables[k] = top.table_opt(kTables[k]);
   if (!tables[0] && !flat) top.table("pid");  // throws: missing [pid]
   TomlTable* F = flat ? &top : nullptr;
-  const std::string pfx = top.path("");
 
   ControllerConfig c;
-  double input[kN];
-  const Spelling* given[kN] = {};
-  std::vector<Spelling> spellings[kN];
-  for (std::size_t i = 0; i < kN; ++i) input[i] = kFields[i].input_default;
+  RowReader r(warn, true, top.path(""), c);
   for (std::size_t k = 0; k < std::size(kTables); ++k) {
     TomlTable* T = tables[k] ? &*tables[k] : nullptr;
-    for (std::size_t i = 0; i < kN; ++i) {
-      const ControllerField& f = kFields[i];
-      if (f.table != std::string_view(kTables[k])) continue;
-      auto& s = spellings[i];
-      s.push_back({T, f.key, false});
-      if (*f.alias != '\0') s.push_back({T, f.alias, true});
-      if (*f.flat != '\0') s.push_back({F, f.flat, true});
-      const std::string canonical = (pfx.empty() ? "" : pfx + ".") + f.table + "." + f.key;
-      given[i] = pick(s, canonical, warn);
-      if (given[i] == nullptr) {
-        if (f.required && T != nullptr) T->number(f.key);  // throws: missing key, named in its table
-        continue;
-      }
-      read_value(*given[i]->table, given[i]->key, f, c, input[i]);
-    }
+    r.read(kTables[k], T, F, true);
     // The cross-field rules of this table, then its unknown keys.
-    if (k == 0 && T != nullptr && !(c.pid.output_min <= c.pid.output_max))
-      T->fail("output_max", "needs output_min <= output_max");
+    if (k == 0) check_output_limits(c.pid, T);
     if (k == 1) {
       const std::size_t d = index_of("deadzone_inverse", "deadzone_mA"), f = index_of("deadzone_inverse", "fraction");
-      if (given[index_of("deadzone_inverse", "offset_mA")] != nullptr) {
-        if (given[d] != nullptr || given[f] != nullptr)
+      if (r.given[index_of("deadzone_inverse", "offset_mA")] != nullptr) {
+        if (r.given[d] != nullptr || r.given[f] != nullptr)
           T->fail("offset_mA", "give either offset_mA or deadzone_mA/fraction, not both");
       } else {
-        c.dz_inverse = DeadzoneInverseParams::from_deadzone(input[d], input[f]);
+        c.dz_inverse = DeadzoneInverseParams::from_deadzone(r.input[d], r.input[f]);
       }
     }
     if (k == 2 && !(c.current_min_mA <= c.current_max_mA)) {
@@ -256,6 +275,15 @@ ControllerConfig read_controller_config(TomlTable& top, const ControllerWarn& wa
     throw InputError(top.file(), top.line(), top.path(""), e.what());
   }
   return c;
+}
+
+void read_pid_fields(TomlTable& t, PidConfig& pid, const ControllerWarn& warn) {
+  ControllerConfig c;
+  c.pid = pid;
+  RowReader r(warn, false, t.path(""), c);
+  r.read("pid", &t, nullptr, false, "dt_s");
+  check_output_limits(c.pid, &t);
+  pid = c.pid;
 }
 
 std::string controller_config_toml(const ControllerConfig& c, const std::string& comment) {

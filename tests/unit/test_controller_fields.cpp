@@ -227,6 +227,50 @@ TEST(ControllerFields, FlagsParseAsTheTomlValuesAndOverridesAreChecked) {
   EXPECT_EQ(error_field({{kp, "2"}, {max, "1500"}}), "no error");
 }
 
+TEST(ControllerFields, InlinePidOfAScenarioUsesTheSameRows) {
+  // A closed-loop scenario's [controller]: the [pid] keys inline, none required, no dt_s.
+  auto read = [](const std::string& name, const std::string& text, std::vector<std::string>& w) {
+    const std::string path = write_file(name, text);
+    const toml::table root = parse_toml_file(path);
+    TomlTable top(root, path);
+    TomlTable c = top.table("controller");
+    PidConfig pid;
+    pid.output_min = -12.0;  // the caller's default (the scenario's min/max)
+    pid.output_max = 12.0;
+    read_pid_fields(c, pid, [&](const std::string& m) { w.push_back(m); });
+    c.finish();
+    return pid;
+  };
+  std::vector<std::string> w;
+  const PidConfig a = read("inline.toml", "[controller]\nkp = 600\nki_per_s = 5000\nkd_s = 15\nn_per_s = 200\n", w);
+  EXPECT_TRUE(w.empty());
+  const PidConfig b = read("inline_old.toml", "[controller]\nkp = 600\nki = 5000\nkd = 15\nn = 200\n", w);
+  ASSERT_EQ(w.size(), 3u);
+  EXPECT_NE(w[0].find("inline_old.toml:3: 'controller.ki' is deprecated, write 'controller.ki_per_s'"),
+            std::string::npos)
+      << w[0];
+  for (const PidConfig* p : {&a, &b}) {
+    EXPECT_EQ(p->gains.kp, 600.0);
+    EXPECT_EQ(p->gains.ki_per_s, 5000.0);
+    EXPECT_EQ(p->gains.kd_s, 15.0);
+    EXPECT_EQ(p->gains.n_per_s, 200.0);
+    EXPECT_EQ(p->dt_s, PidConfig{}.dt_s);  // not read here
+    EXPECT_EQ(p->output_min, -12.0);       // kept when not given
+    EXPECT_EQ(p->output_max, 12.0);
+  }
+  // dt_s is not a row of the inline table: finish() calls it unknown; a range error has no unit.
+  EXPECT_THROW(read("inline_dt.toml", "[controller]\ndt_s = 0.01\n", w), InputError);
+  try {
+    read("inline_bad.toml", "[controller]\nkp = 1\nkd = -2\n", w);
+    ADD_FAILURE() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.line(), 3);
+    EXPECT_EQ(e.field(), "controller.kd");
+    EXPECT_NE(std::string(e.what()).find("must be >= 0"), std::string::npos);
+    EXPECT_EQ(std::string(e.what()).find("mA"), std::string::npos) << e.what();
+  }
+}
+
 TEST(ControllerFields, DocsShowTheGeneratedKeysTable) {
   std::ifstream in(std::string(LASH_SOURCE_DIR) + "/docs/control.md");
   std::stringstream doc;

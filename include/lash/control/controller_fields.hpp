@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "lash/control/controller.hpp"
+#include "lash/control/gains_file.hpp"
 #include "lash/io/toml_util.hpp"
 
 namespace lash {
@@ -49,6 +50,14 @@ struct ControllerField {
 std::span<const ControllerField> controller_fields() noexcept;
 /// The field with command-line flag `flag` (no dashes), or nullptr.
 const ControllerField* find_controller_field_by_flag(std::string_view flag) noexcept;
+
+/// Reads the [pid] rows (but dt_s) of the field table from `t` into `pid`: a PID written inline,
+/// as the `[controller]` table of a closed-loop scenario (experiments/closed_loop_scenario.hpp)
+/// does, at the caller's sample period and in the caller's units. Only keys given change `pid`;
+/// none is required; deprecated aliases (ki, kd, n) warn as in a gains file (`warn` empty:
+/// stderr); then output_min <= output_max. Errors are InputError naming file, line and key.
+/// Leaves `t`'s unknown keys to the caller's finish().
+void read_pid_fields(TomlTable& t, PidConfig& pid, const ControllerWarn& warn = {});
 
 /// Whether `f` takes a name (integrator, anti_windup) rather than a number.
 bool controller_field_is_name(const ControllerField& f) noexcept;
