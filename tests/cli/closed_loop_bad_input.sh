@@ -53,4 +53,19 @@ for a in "--after 1e9" "--after -1" "--after 0" "--settle 1e7" "--settle nan"; d
   out=$("$LASH" closed-loop $a 2>&1); rc=$?
   [[ $rc -eq 2 && $out == *"'${a%% *}'"* ]] && echo "ok   closed-loop $a: $out" || { echo "FAIL closed-loop $a: $rc $out"; fail=1; }
 done
+# Controller override flags (generated from the field table): bad values exit 2 naming the flag,
+# nothing written; a flag gives the same loop as the same key in the gains file (identity).
+for a in "--kp -1" "--ki-per-s x" "--dt-s 0" "--integrator euler" "--min-mA 3000" "--offset-mA nan"; do
+  out=$("$LASH" closed-loop $a -o "$d/ov.csv" 2>&1); rc=$?
+  [[ $rc -eq 2 && $out == *"'${a%% *}'"* && ! -e "$d/ov.csv" ]] && echo "ok   closed-loop $a: $out" \
+    || { echo "FAIL closed-loop $a: $rc $out"; fail=1; }
+done
+out=$("$LASH" closed-loop --scenario "$d/ok.toml" --kp 1 2>&1); rc=$?
+[[ $rc -eq 2 && $out == *"'--kp'"*"scenario"* ]] || { echo "FAIL --kp with --scenario: $rc $out"; fail=1; }
+gains="${LASH_SOURCE_DIR}/config/control/thesis_gains.toml"
+sed -e 's/^ki_per_s = .*/ki_per_s = 671.56/' -e 's/^fraction = .*//' -e 's/^deadzone_mA = .*/offset_mA = 291/' "$gains" > "$d/half_ki.toml"
+grep -q "^ki_per_s = 671.56" "$d/half_ki.toml" && grep -q "^offset_mA = 291" "$d/half_ki.toml" || { echo "FAIL thesis_gains.toml changed: update this test"; fail=1; }
+a=$("$LASH" closed-loop --gains "$d/half_ki.toml" --json); b=$("$LASH" closed-loop --ki-per-s 671.56 --offset-mA 291 --json)
+[[ -n $a && $a == "$b" ]] && echo "ok   --ki-per-s 671.56 --offset-mA 291 = the same keys in the file" \
+  || { echo "FAIL override != file: $a vs $b"; fail=1; }
 exit $fail
