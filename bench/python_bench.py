@@ -153,15 +153,25 @@ def main():
     with tempfile.TemporaryDirectory() as d:
         fleet.generate(d, args.fleet_records, duration_s=args.fleet_duration)
         files = fleet.records(d)
-        times = {}
+        times, cpu = {}, {}
         for workers in (1, 2):
             # the example's own cluster: worker processes of one thread, its allocator settings (WORKER_ENV)
             with fleet.local_cluster(workers) as c, Client(c) as client:
                 fleet.identify_on(client, files[:2 * workers])  # warm-up: import lash on every worker
+                w0, c0 = client.run(time.process_time), time.process_time()
                 times[workers] = median_of(lambda: fleet.identify_on(client, files), args.fleet_repeat)
+                w1, c1 = client.run(time.process_time), time.process_time()
+                cpu[workers] = ([(w1[k] - w0[k]) / args.fleet_repeat for k in sorted(w1)],
+                                (c1 - c0) / args.fleet_repeat)
         print("3. fleet of %d records x %g s: 1 worker %.2f s, 2 workers %.2f s (medians of %d) -> speed-up %.2f"
               " (goal >= 1.7); load average %.1f" % (len(files), args.fleet_duration, times[1], times[2],
                                                      args.fleet_repeat, times[1] / times[2], os.getloadavg()[0]))
+        for workers in (1, 2):
+            # CPU seconds per run: how evenly the work is split, what the client and scheduler take, and
+            # how many cores the run got (a shared host's other sessions take the rest)
+            print("   %d worker(s): CPU per run %s s in the workers, %.2f s in the client and scheduler;"
+                  " %.2f cores used" % (workers, " + ".join("%.2f" % x for x in cpu[workers][0]), cpu[workers][1],
+                                        (sum(cpu[workers][0]) + cpu[workers][1]) / times[workers]))
     return 0
 
 
