@@ -3,7 +3,7 @@
    tracking figures of `lash closed-loop --scenario` on the same file (the same nodes run both);
    live: on every attempt 0 kPa from the simulation on the observed schedule; bit-identical when every step used its own frame
    (off_schedule_steps == 0); with a few late frames (<= 1 % of the steps) the RMS figures of the
-   windows without a safe-state episode within 15 % (the adaptive law holds on a stale sample); up to four attempts on a
+   windows without a safe-state episode within 20 % (the adaptive law holds on a stale sample); up to four attempts on a
    busy host; the master's TET mean with adaptation on is printed (a timing figure, not asserted);
  - a coupled_carts scenario, or --compensation without --scenario, is refused with exit 2;
  - the default `lash hil run --duration 5` (live, two processes in the run's own network
@@ -68,11 +68,12 @@ for mode in ("fixed", "adaptive"):
 #  (b) no step off schedule: every tracking figure, the final inverse and the update count
 #      bit-identical;
 #  (c) a few late frames (off-schedule steps <= 1 % = 80): each figure whose window saw no
-#      safe-state episode (below) has its RMS within 15 % of closed-loop's and its max |error|
-#      within 1.5x. Justification (docs/compensation.md): 50 synthetic schedules with 40 or 80
-#      late frames at random steps (lash hil simulate --schedule) gave RMS ratios 0.96..1.12 and
-#      max ratios 0.58..1.34 against closed-loop: a late frame holds the command for a step, and
-#      the adaptive law holds on it (the estimator is restarted, the inverse keeps its edges).
+#      safe-state episode (below) has its RMS within 20 % of closed-loop's and its max |error|
+#      within 2x. Justification (docs/compensation.md, scripts/late_frame_study.py): synthetic
+#      schedules with 40 to 80 late frames at random steps, replayed by lash hil simulate
+#      --schedule, gave RMS ratios 0.96..1.15 and max ratios 0.55..1.40 against closed-loop: a
+#      late frame holds the command for a step, and the adaptive law holds on it (the estimator
+#      is restarted, the inverse keeps its edges).
 #  A host stall of >= fault_missed_periods (3) steps sends the master to its safe state (0 mA,
 #  PI reset, docs/hil.md): a transient of up to ~370 kPa that is the safety rule's, not the
 #  law's. A window with such an episode in it (or in the 2 s before it) is not compared; the
@@ -123,10 +124,10 @@ for attempt in range(4):
                 print(f"attempt {attempt}: {w} not compared (safe-state episode at {safe_t} s)")
                 continue
             a, b = rep[w]["rms_error"], ref[w]["rms_error"]
-            check(abs(a / b - 1.0) <= 0.15, f"attempt {attempt} ({rep['off_schedule_steps']} off-schedule): {w}.rms_error "
-                  f"{a:.4g} within 15 % of closed-loop's {b:.4g} (ratio {a / b:.3f})")
+            check(abs(a / b - 1.0) <= 0.2, f"attempt {attempt} ({rep['off_schedule_steps']} off-schedule): {w}.rms_error "
+                  f"{a:.4g} within 20 % of closed-loop's {b:.4g} (ratio {a / b:.3f})")
             a, b = rep[w]["max_abs_error"], ref[w]["max_abs_error"]
-            check(a <= 1.5 * b, f"attempt {attempt}: {w}.max_abs_error {a:.4g} <= 1.5 x closed-loop's {b:.4g}")
+            check(a <= 2.0 * b, f"attempt {attempt}: {w}.max_abs_error {a:.4g} <= 2 x closed-loop's {b:.4g}")
             few.append(w)
         if "tracking" in few:
             break
