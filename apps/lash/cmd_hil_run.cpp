@@ -170,7 +170,7 @@ int run_simulate(const SimulateOptions& o) {
   hil::SimulationResult sim;
   if (o.schedule.empty()) {
     N = hil::steps_for(duration, s.step_s, "--duration");
-    sim = hil::simulate_bench(L, mc, sc, N);
+    sim = hil::simulate_bench(L, mc, sc, hil::ideal_schedule(N));
   } else {  // the run's own schedule: as many control steps as master.csv holds
     const std::filesystem::path mpath(o.schedule);
     const std::filesystem::path spath =

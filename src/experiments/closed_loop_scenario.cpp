@@ -6,7 +6,7 @@
 
 #include "lash/control/controller_fields.hpp"
 #include "lash/hil/node_run.hpp"
-#include "lash/hil/simulate.hpp"
+#include "lash/hil/schedule.hpp"
 #include "lash/identify/config_file.hpp"
 #include "lash/io/error.hpp"
 #include "lash/io/toml_util.hpp"
@@ -325,7 +325,7 @@ ClosedLoopScenarioResult run_closed_loop_scenario(const ClosedLoopScenario& s, C
     apply_to_bench(s, mode, b);
     const hil::BenchLayout L;  // the layout of config/hydraulic_bench.dbc
     const hil::SimulationResult sim =
-        hil::simulate_bench(L, hil::master_config(b, ""), hil::slave_config(b, L), n);
+        hil::simulate_bench(L, hil::master_config(b, ""), hil::slave_config(b, L), hil::ideal_schedule(n));
     for (std::size_t m = 0; m < n && m + 1 < sim.master.size() && m < sim.slave.size(); ++m) {
       const auto& ml = sim.master[m + 1];  // master row 0 is the CONNECT step
       record(res.trace, static_cast<double>(m) * dt, ml.reference_kPa, sim.slave[m].pressure_kPa, ml.current_mA,
@@ -366,7 +366,7 @@ ClosedLoopScenarioResult run_closed_loop_scenario(const ClosedLoopScenario& s, C
       const double ff = s.feedforward * (wstar - wstar1) / dt;  // velocity feedforward
       wstar1 = wstar;
       const double v = clamp(pid.step(wstar - w) + ff, s.command_min, s.command_max);
-      comp.observe(w, y);
+      comp.observe(w, y, true);  // simulated: every sample fresh
       const PerSide<double> used = comp.in_use();
       record(res.trace, t, r, y, v, used.right, used.left);
       res.trace.drive.push_back(w);

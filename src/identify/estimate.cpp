@@ -1,6 +1,7 @@
 #include "lash/identify/estimate.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "lash/io/csv.hpp"
@@ -62,17 +63,22 @@ ArrayEstimate estimate_arrays(const SettingsSources& src, std::span<const double
                        "has " + std::to_string(col.size()) + " samples, t has " + std::to_string(t.size()));
   sample_period(t);  // t: at least 3 samples, strictly increasing
   ArrayEstimate out;
-  out.sampling = analyse_sampling(t);
+  out.sampling = o.sampling ? *o.sampling : analyse_sampling(t);
   const Sampling& smp = out.sampling;
   const EstimateSettings set = resolve_settings(src, smp.dt, v, y);
   out.preset = set.preset;
+  out.job = set.job;
+  const auto t_start = std::chrono::steady_clock::now();
   out.run = estimate_auto(set.cfg, v, y, o.trace, o.outlier_gate, smp.gap_rows);
+  out.estimator_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   if (o.intervals) add_intervals(out.run.run, out.run.cfg, v, y, smp.gap_rows);
   out.result = score_estimate(out.run.run.report, smp.dt, set.job, t, y, out.run.run.ysim, true);
-  ReportFit fit = report_fit(out.result);  // as the CLI's: gaps and the median step of t too
-  fit.gaps = smp.gap_rows.size();
-  fit.median_dt_s = smp.median_dt;
-  out.json = estimate_auto_json(out.run, set.preset, fit);
+  out.fit = report_fit(out.result);  // with what the reader found: skipped rows, gaps, median step of t
+  out.fit.rows_skipped = o.rows_skipped;
+  out.fit.first_skipped_line = o.first_skipped_line;
+  out.fit.gaps = smp.gap_rows.size();
+  out.fit.median_dt_s = smp.median_dt;
+  out.json = estimate_auto_json(out.run, set.preset, out.fit);
   return out;
 }
 

@@ -52,14 +52,22 @@ struct ArrayEstimateOptions {
   bool trace = false;          ///< keep every parameter per sample (run.run.params)
   double outlier_gate = 12.0;  ///< estimate_auto's outlier gate [innovation scales] (0 = off)
   bool intervals = true;       ///< the 95 % intervals (add_intervals: one more estimator pass over sections)
+  /// The sampling of t when the caller has it already (a file's reader analysed it): else analysed here.
+  const Sampling* sampling = nullptr;
+  std::size_t rows_skipped = 0;  ///< rows the reader dropped for a non-finite value (reported, not used)
+  int first_skipped_line = 0;    ///< file line of the first of them
 };
 
-/// One whole-record estimation from arrays, as `lash estimate` makes it from a file.
+/// One whole-record estimation from arrays: `lash estimate` (on a file's columns) and Python's
+/// lash.estimate make exactly this call.
 struct ArrayEstimate {
   AutoRun run;            ///< settings of the final run, per-sample yhat/ysim, guesses, outliers
   EstimateResult result;  ///< report, dt, NRMSE and its window
   Sampling sampling;      ///< gaps and median step of t
   Preset preset = Preset::lash;
+  EstimationJob job;      ///< the job part of the resolved settings (columns, NRMSE window)
+  ReportFit fit;          ///< the fit part of the report (NRMSE, window, skipped rows, gaps, median step)
+  double estimator_s = 0.0;  ///< wall time of estimate_auto alone [s] (`lash estimate --timing`)
   std::string json;       ///< what `lash estimate --json` prints (estimate_auto_json)
 };
 
