@@ -448,8 +448,11 @@ double DeadzoneDeadbandEstimator::predict_free(Side side, double y1, double v1) 
   // − model lands below it, otherwise the output holds.
   double up, down;
   if (cfg_.pooled) {
-    up = pooled_[side].predict({-y1, v1, 1.0, -1.0});
-    down = pooled_[side].predict({-y1, v1, 1.0, 1.0});
+    // φᵀη with φ = [−y1, v1, 1, ∓1]: the shared part once, then ∓g (the same sums as predict())
+    const auto& e = pooled_[side].eta();
+    const double base = (0.0 + -y1 * e[0] + v1 * e[1]) + e[2];
+    up = base - e[3];
+    down = base + e[3];
   } else {
     up = rls_[key(side, true)].predict({-y1, v1, 1.0});
     down = rls_[key(side, false)].predict({-y1, v1, 1.0});

@@ -63,6 +63,66 @@ TEST(Rls, FirstStepMatchesHandComputation) {
   EXPECT_NEAR(r.P()[1][1], (10.0 - 400.0 / 50.5) / 0.5, 1e-12);
 }
 
+/// Recursive IV with λ = 1 solves the normal equations of IV exactly (Söderström & Stoica 1989,
+/// §8): with R = P0⁻¹ + Σ z φᵀ and b = P0⁻¹ η0 + Σ z y, P = R⁻¹ and η = R⁻¹ b. Checked without an
+/// inverse: R·P = I and R·η = b, with R and b summed in long double from the same samples.
+/// With λ = 0.999: P = (λᵏ P0⁻¹ + Σ λ^(k−i) z φᵀ)⁻¹ likewise.
+template <std::size_t N>
+void iv_solves_normal_equations(double lambda) {
+  RlsConfig<N> c;
+  c.lambda = lambda;
+  c.p0 = 100.0;
+  for (std::size_t i = 0; i < N; ++i) c.eta0[i] = 0.5;
+  Rls<N> r(c);
+  Rng rng(3);
+  long double R[N][N] = {}, b[N] = {};
+  for (std::size_t i = 0; i < N; ++i) {
+    R[i][i] = 1.0L / c.p0;
+    b[i] = 0.5L / c.p0;
+  }
+  double y1 = 0.0, y2 = 0.0, y3 = 0.0;
+  for (int k = 0; k < 3000; ++k) {
+    const double v = std::sin(0.01 * k) * 50.0 + rng.gaussian();
+    const double y = 0.9 * y1 + 0.2 * v + 0.3 + rng.gaussian();
+    typename Rls<N>::Vec phi{}, z{};
+    const double f[4] = {-y1, v, 1.0, k % 2 ? 1.0 : -1.0}, g[4] = {-y3, v, 1.0, k % 2 ? 1.0 : -1.0};
+    for (std::size_t i = 0; i < N; ++i) {
+      phi[i] = f[i];
+      z[i] = g[i];
+    }
+    r.update_iv(phi, z, y);
+    for (std::size_t i = 0; i < N; ++i) {
+      b[i] = lambda * b[i] + static_cast<long double>(z[i]) * y;
+      for (std::size_t j = 0; j < N; ++j) R[i][j] = lambda * R[i][j] + static_cast<long double>(z[i]) * phi[j];
+    }
+    y3 = y2;
+    y2 = y1;
+    y1 = y;
+  }
+  double worst_p = 0.0, worst_eta = 0.0;
+  for (std::size_t i = 0; i < N; ++i) {
+    long double re = 0.0L, bn = 0.0L;
+    for (std::size_t j = 0; j < N; ++j) {
+      long double rp = 0.0L;
+      for (std::size_t m = 0; m < N; ++m) rp += R[i][m] * r.P()[m][j];
+      worst_p = std::max(worst_p, static_cast<double>(std::fabs(rp - (i == j ? 1.0L : 0.0L))));
+      re += R[i][j] * r.eta(j);
+    }
+    bn = std::fabs(b[i]) + 1.0L;
+    worst_eta = std::max(worst_eta, static_cast<double>(std::fabs(re - b[i]) / bn));
+  }
+  EXPECT_LT(worst_p, 1e-9) << "N = " << N;
+  EXPECT_LT(worst_eta, 1e-9) << "N = " << N;
+  EXPECT_EQ(r.updates(), 3000u);
+}
+
+TEST(Rls, IvSolvesTheNormalEquations) {
+  iv_solves_normal_equations<3>(1.0);
+  iv_solves_normal_equations<4>(1.0);  // the pooled deadzone-deadband regression (its own code path)
+  iv_solves_normal_equations<3>(0.999);
+  iv_solves_normal_equations<4>(0.999);
+}
+
 TEST(Rls, NonFiniteSampleIsSkippedAndCounted) {
   Rls<3> r(RlsConfig<3>{});
   r.update({1.0, 2.0, 1.0}, 4.0);
