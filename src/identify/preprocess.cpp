@@ -26,6 +26,7 @@ Preprocessor::Preprocessor(const NoiseSettings& s, double dt_s)
   const std::size_t need = std::max({lag_v_, lag_y_, lag_d_}) + 1;
   while (cap_ < need) cap_ *= 2;
   mask_ = cap_ - 1;
+  x_ring_ = separate_pre_ ? 2 * cap_ : cap_;
   hist_.assign(3 * cap_, 0.0);
 }
 

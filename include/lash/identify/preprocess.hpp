@@ -40,10 +40,10 @@ class Preprocessor {
     double* const h = hist_.data();
     h[k] = vf;
     h[cap_ + k] = yf;
-    h[2 * cap_ + k] = x;
+    if (separate_pre_) h[2 * cap_ + k] = x;  // otherwise x = y_f, read from y_f's ring
     // MA_M2 of the backward difference telescopes: (1/M2)·Σ_{j<M2} (x(k−j) − x(k−j−1))/T
     // = (x(k) − x(k−M2))/(M2·T), with x = 0 before the first sample as in every filter.
-    const double d = (x - h[2 * cap_ + ((k - lag_d_) & mask_)]) * inv_ddt_;
+    const double d = (x - h[x_ring_ + ((k - lag_d_) & mask_)]) * inv_ddt_;
     return {h[(k - lag_v_) & mask_], h[cap_ + ((k - lag_y_) & mask_)], d};
   }
 
@@ -64,7 +64,7 @@ class Preprocessor {
   MovingAverage ma_y_, ma_v_, ma_p_;
   // One history ring per signal (v_f, y_f, derivative input), cap_ (a power of two) slots each:
   // the input and alignment delays and the derivative read from it.
-  std::size_t cap_ = 1, mask_ = 0;
+  std::size_t cap_ = 1, mask_ = 0, x_ring_ = 0;
   std::size_t lag_v_ = 0, lag_y_ = 0, lag_d_ = 1;
   std::uint64_t k_ = 0;
   std::vector<double> hist_;

@@ -228,7 +228,7 @@ class Rls {
   /// operations in the same order on either compiler). P is kept by rows, so φᵀP is a sum of
   /// scaled rows and Pz a dot product per row, summed as (P_i0 z0 + P_i2 z2) + (P_i1 z1 + P_i3 z3).
   /// The rank-1 update is P −= q (φᵀP) with q = Pz/(λ + φᵀPz) formed once (4 products instead of 16).
-  double update_iv4(const Vec& phi, const Vec& z, double y) noexcept {
+  __attribute__((always_inline)) double update_iv4(const Vec& phi, const Vec& z, double y) noexcept {
     using v2 = double __attribute__((vector_size(16)));
     auto load = [](const double* a) noexcept {
       v2 r;
