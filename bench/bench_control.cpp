@@ -70,7 +70,7 @@ void BM_AdaptiveControllerStep(benchmark::State& state) {
     k = k + 1 == ref.size() ? 0 : k + 1;
     const double u = pid.step(r - y) + 0.465 * r;
     const double i = comp.command(u);
-    comp.observe(i, y);
+    comp.observe(i, y, true);
     const double dz = i > 288.0 ? i - 288.0 : (i < -296.0 ? i + 296.0 : 0.0);
     x = 0.93 * x + 0.07 * 2.15 * dz;
     y = x;

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <vector>
 
+#include "e1_plant.hpp"
+
 #include "lash/identify/auto.hpp"
 #include "lash/identify/auto_gate.hpp"
 #include "lash/identify/estimators.hpp"
@@ -19,12 +21,7 @@ struct Data {
 
 const Data& e1_data() {
   static const Data d = [] {
-    using namespace lash;
-    std::vector<Block> b;
-    b.emplace_back(Deadzone({-300.0, 200.0}));
-    b.emplace_back(FirstOrder({{-0.96, 0.1}, {-0.94, 0.15}}));
-    b.emplace_back(Deadband({30.0, 50.0}));
-    Plant p(std::move(b), 0.005);
+    lash::Plant p = lash::bench::e1_plant();
     Data out;
     const std::size_t n = 1 << 16;  // 327 s: a whole number of input periods is not needed
     for (std::size_t k = 0; k < n; ++k) {

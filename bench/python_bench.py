@@ -1,13 +1,16 @@
 #!/usr/bin/env python3
 """Speed of the lash Python package, as ratios printed in one run (docs/python.md):
 
-1. lash.estimate on 10^6 samples from numpy arrays, per sample, against the C++ Google
-   Benchmark of the same estimator on the same plant data (BM_DeadzoneDeadband of lash_bench);
-   goal: ratio <= 1.2. Timed with intervals=False (the estimator pass the benchmark times); the
-   default intervals=True runs the estimator once more over sections and is printed too.
+1. lash.estimate on 10^6 samples from numpy arrays, per sample, against two C++ Google Benchmarks
+   on the same plant data, Python and C++ alternating `--rounds` times (each side the best of 5 calls;
+   the median of the per-round ratios printed): BM_EstimateArrays (bench_estimate_auto.cpp: the same library call, lash::estimate_arrays,
+   on the same 10^6 samples; goal: ratio <= 1.2, i.e. no per-sample Python work) and
+   BM_DeadzoneDeadband (bench_identify.cpp: the bare estimator step alone, data in cache). Timed with
+   the benchmarks' settings (thesis preset, guesses given, outlier gate off, intervals=False); the
+   defaults (preset lash, gate, intervals: more passes) are printed too.
 2. The per-call overhead of Estimator.update (one Python call per sample) over update_many.
-3. The fleet example (examples/python/05_fleet.py) on a LocalCluster of 2 workers against 1
-   worker (cluster start-up not timed); goal: speed-up >= 1.7 on 2 cores.
+3. The fleet example (examples/python/05_fleet.py) on its LocalCluster of 2 worker processes against
+   1 (cluster start-up not timed, medians of --fleet-repeat runs); goal: speed-up >= 1.7 on 2 cores.
 
     PYTHONPATH=build/python /usr/bin/python3 bench/python_bench.py [--lash-bench build/bin/lash_bench]
 """
@@ -15,6 +18,7 @@ import argparse
 import importlib.util
 import json
 import os
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -24,6 +28,9 @@ import numpy as np
 
 import lash
 
+# bench_estimate_auto.cpp's benchmarks time one call on 10^6 samples; bench_identify.cpp's one sample
+ESTIMATE_ARRAYS_SAMPLES = 10 ** 6
+PER_CALL = ("BM_EstimateArrays", "BM_RunEstimator")
 HERE = os.path.dirname(os.path.abspath(__file__))
 SRC = os.path.dirname(HERE)
 
@@ -35,6 +42,15 @@ def best_of(fn, repeat):
         fn()
         best = min(best, time.perf_counter() - t0)
     return best
+
+
+def median_of(fn, repeat):
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
 
 
 def e1_data(n):
@@ -49,42 +65,69 @@ def e1_data(n):
     return tr["t"], tr["v"], tr["y"]
 
 
-def cpp_ns_per_sample(lash_bench, name):
-    out = subprocess.run([lash_bench, "--benchmark_filter=^%s$" % name, "--benchmark_format=json",
-                          "--benchmark_repetitions=5", "--benchmark_report_aggregates_only=true"],
-                         capture_output=True, text=True, check=True)
+def cpp_ns_per_sample(lash_bench, names, calls):
+    """Per sample [ns], for each Google Benchmark in `names` (one lash_bench run): the best of `calls`
+    repetitions of the shortest run Google Benchmark makes (one call of BM_EstimateArrays)."""
+    out = subprocess.run([lash_bench, "--benchmark_filter=^(%s)(/real_time)?$" % "|".join(names),
+                          "--benchmark_format=json", "--benchmark_repetitions=%d" % calls,
+                          "--benchmark_min_time=0.01"], capture_output=True, text=True, check=True)
+    ns = {}
     for b in json.loads(out.stdout)["benchmarks"]:
-        if b.get("aggregate_name") == "median":
-            return b["real_time"] * {"ns": 1.0, "us": 1e3, "ms": 1e6}[b["time_unit"]]
-    raise RuntimeError("no median in lash_bench output")
+        if b.get("run_type") != "iteration":
+            continue
+        t = b["real_time"] * {"ns": 1.0, "us": 1e3, "ms": 1e6}[b["time_unit"]]
+        name = b["run_name"].split("/")[0]
+        t /= ESTIMATE_ARRAYS_SAMPLES if name in PER_CALL else 1
+        ns[name] = min(ns.get(name, t), t)
+    missing = [n for n in names if n not in ns]
+    if missing:
+        raise RuntimeError("no run of %s in lash_bench output" % missing)
+    return ns
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--lash-bench", default=os.path.join(SRC, "build", "bin", "lash_bench"))
+    ap.add_argument("--rounds", type=int, default=5, help="Python/C++ alternations for the ratios of 1.")
     ap.add_argument("--fleet-records", type=int, default=80)
     ap.add_argument("--fleet-duration", type=float, default=200.0, help="record length [s]")
+    ap.add_argument("--fleet-repeat", type=int, default=3, help="fleet runs per cluster (median)")
     ap.add_argument("--no-fleet", action="store_true", help="skip the fleet speed-up")
     args = ap.parse_args()
 
-    n = 10 ** 6
+    n = ESTIMATE_ARRAYS_SAMPLES
     t, v, y = e1_data(n)
     settings = dict(guess_left=-350.0, guess_right=350.0)
-    # the benchmark's estimator: thesis settings, given guesses, no outlier gate, no intervals
+    # the benchmarks' settings: thesis preset, given guesses, no outlier gate, no intervals
     same = dict(preset="thesis", outlier_gate=0, intervals=False, **settings)
     lash.estimate(t, v, y, **same)
-    py_s = best_of(lambda: lash.estimate(t, v, y, **same), 7)
-    py_ns = py_s / n * 1e9
-    full_ns = best_of(lambda: lash.estimate(t, v, y, **settings), 3) / n * 1e9
+    have_cpp = os.path.exists(args.lash_bench)
+    # Python and C++ alternate, `rounds` times, so that a change of the host's load hits both; the
+    # ratios are taken within each round and their median printed.
+    # Each side of a round: the best of 5 calls (an other job's time slice only ever adds time).
+    rows = []
+    for _ in range(args.rounds):
+        py_ns = best_of(lambda: lash.estimate(t, v, y, **same), 5) / n * 1e9
+        cpp = cpp_ns_per_sample(args.lash_bench, ["BM_EstimateArrays", "BM_DeadzoneDeadband"], 5) if have_cpp else {}
+        rows.append((py_ns, cpp))
+    py_ns = statistics.median(r[0] for r in rows)
+    full_ns = median_of(lambda: lash.estimate(t, v, y, **settings), 3) / n * 1e9
     print("1. lash.estimate, deadzone-deadband, 10^6 samples from numpy: %.2f ns/sample (%.1f M samples/s) with the"
-          " benchmark's settings; %.2f ns/sample with the defaults (preset lash, outlier gate, 95 %% intervals)"
+          " benchmarks' settings; %.2f ns/sample with the defaults (preset lash, outlier gate, 95 %% intervals)"
           % (py_ns, 1e3 / py_ns, full_ns))
-    if os.path.exists(args.lash_bench):
-        cpp = cpp_ns_per_sample(args.lash_bench, "BM_DeadzoneDeadband")
-        print("   C++ benchmark BM_DeadzoneDeadband: %.2f ns/sample -> ratio Python/C++ = %.3f (goal <= 1.2)"
-              % (cpp, py_ns / cpp))
+    if have_cpp:
+        same_call = [r[0] / r[1]["BM_EstimateArrays"] for r in rows]
+        bare = [r[0] / r[1]["BM_DeadzoneDeadband"] for r in rows]
+        print("   C++ BM_EstimateArrays (the same library call, lash::estimate_arrays): %.2f ns/sample"
+              " -> ratio Python/C++ = %.3f (goal <= 1.2; rounds: %s)"
+              % (statistics.median(r[1]["BM_EstimateArrays"] for r in rows), statistics.median(same_call),
+                 ", ".join("%.3f" % x for x in same_call)))
+        print("   C++ BM_DeadzoneDeadband (the bare estimator step, 65536 samples in cache): %.2f ns/sample"
+              " -> ratio = %.3f (rounds: %s)"
+              % (statistics.median(r[1]["BM_DeadzoneDeadband"] for r in rows), statistics.median(bare),
+                 ", ".join("%.3f" % x for x in bare)))
     else:
-        print("   (no %s: build the lash_bench target for the C++ ratio)" % args.lash_bench)
+        print("   (no %s: build the lash_bench target for the C++ ratios)" % args.lash_bench)
 
     m = 200000
     e = lash.Estimator("deadzone-deadband", 0.005, **settings)
@@ -105,19 +148,30 @@ def main():
     spec = importlib.util.spec_from_file_location("fleet", os.path.join(SRC, "examples", "python", "05_fleet.py"))
     fleet = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(fleet)
-    from dask.distributed import Client, LocalCluster
+    from dask.distributed import Client
 
     with tempfile.TemporaryDirectory() as d:
         fleet.generate(d, args.fleet_records, duration_s=args.fleet_duration)
         files = fleet.records(d)
-        times = {}
+        times, cpu = {}, {}
         for workers in (1, 2):
-            with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None) as c, \
-                    Client(c) as client:
-                fleet.identify_on(client, files[:workers])  # warm-up: import lash on every worker
-                times[workers] = best_of(lambda: fleet.identify_on(client, files), 3)
-        print("3. fleet of %d records x %g s: 1 worker %.2f s, 2 workers %.2f s -> speed-up %.2f (goal >= 1.7)"
-              % (len(files), args.fleet_duration, times[1], times[2], times[1] / times[2]))
+            # the example's own cluster: worker processes of one thread, its allocator settings (WORKER_ENV)
+            with fleet.local_cluster(workers) as c, Client(c) as client:
+                fleet.identify_on(client, files[:2 * workers])  # warm-up: import lash on every worker
+                w0, c0 = client.run(time.process_time), time.process_time()
+                times[workers] = median_of(lambda: fleet.identify_on(client, files), args.fleet_repeat)
+                w1, c1 = client.run(time.process_time), time.process_time()
+                cpu[workers] = ([(w1[k] - w0[k]) / args.fleet_repeat for k in sorted(w1)],
+                                (c1 - c0) / args.fleet_repeat)
+        print("3. fleet of %d records x %g s: 1 worker %.2f s, 2 workers %.2f s (medians of %d) -> speed-up %.2f"
+              " (goal >= 1.7); load average %.1f" % (len(files), args.fleet_duration, times[1], times[2],
+                                                     args.fleet_repeat, times[1] / times[2], os.getloadavg()[0]))
+        for workers in (1, 2):
+            # CPU seconds per run: how evenly the work is split, what the client and scheduler take, and
+            # how many cores the run got (a shared host's other sessions take the rest)
+            print("   %d worker(s): CPU per run %s s in the workers, %.2f s in the client and scheduler;"
+                  " %.2f cores used" % (workers, " + ".join("%.2f" % x for x in cpu[workers][0]), cpu[workers][1],
+                                        (sum(cpu[workers][0]) + cpu[workers][1]) / times[workers]))
     return 0
 
 

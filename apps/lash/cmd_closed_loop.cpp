@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.hpp"
+#include "controller_options.hpp"
 #include "plot.hpp"
 #include "lash/control/closed_loop.hpp"
 #include "lash/control/gains_file.hpp"
@@ -26,6 +27,7 @@ struct Options {
   bool online = false;
   std::string out, plot;
   std::string scenario, compensation = "adaptive";
+  std::vector<ControllerOverride> controller;  // --kp, --ki-per-s, … (after the gains file)
 };
 
 nlohmann::json metrics_json(const StepMetrics& m) {
@@ -70,9 +72,15 @@ int run_online(const Options& o, const ControllerConfig& thesis, const StepTest&
 }
 
 int run(const Options& o) {
-  if (!o.scenario.empty()) return run_closed_loop_scenario_cmd(o.scenario, o.compensation, o.json, o.out, o.plot);
+  if (!o.scenario.empty()) {
+    if (!o.controller.empty())
+      throw InputError("", 0, std::string("--") + o.controller.front().field->flag,
+                       "with --scenario the scenario's [controller] table sets the controller");
+    return run_closed_loop_scenario_cmd(o.scenario, o.compensation, o.json, o.out, o.plot);
+  }
   const std::string gains_path = o.gains.empty() ? source_dir() + "/config/control/thesis_gains.toml" : o.gains;
   ControllerConfig c = load_controller_config(gains_path);
+  apply_controller_overrides(c, o.controller);
   PilotValveParams p;
   p.deadzone_mA = o.deadzone;
   p.gain_kPa_per_mA = o.gain;
@@ -163,6 +171,7 @@ Command add_closed_loop(CLI::App& app) {
   sub->add_option("--compensation", o->compensation, "With --scenario: none | fixed | adaptive (default adaptive)");
   sub->add_option("-o,--output", o->out, "Write both traces as CSV");
   sub->add_option("--plot", o->plot, "Also render a PNG (needs -o)");
+  add_controller_options(sub, o->controller, true);
   return {sub, [o] { return run(*o); }};
 }
 

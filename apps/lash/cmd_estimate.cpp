@@ -1,5 +1,4 @@
 // lash estimate: run one of the switching estimators of SPEC A4 over a recorded t,v,y file.
-#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -13,6 +12,7 @@
 #include "estimate_settings.hpp"
 #include "lash/identify/any_estimator.hpp"
 #include "lash/identify/auto.hpp"
+#include "lash/identify/estimate.hpp"
 #include "lash/identify/estimate_report.hpp"
 #include "lash/identify/data.hpp"
 
@@ -48,51 +48,41 @@ int run(const CLI::App& sub, const EstimateOptions& o) {
     throw InputError(o.data, 0, "--nrmse-window",
                      "T0 = " + format_double(job.nrmse_t0_s) + " s is not before the record's end (" +
                          format_double(rec.t().back()) + " s)");
-  const EstimateSettings set = resolve_settings(src, rec.dt_s, rec.v(), rec.y());
-  const EstimatorConfig& cfg = set.cfg;
-  const bool keep = !o.out.empty() || !o.plot.empty();
-  const auto t_start = std::chrono::steady_clock::now();
-  AutoRun ar = estimate_auto(cfg, rec.v(), rec.y(), keep, o.outlier_gate, rec.gap_rows());
-  EstimationRun& run = ar.run;
-  const double elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  ArrayEstimateOptions eo;
+  eo.trace = !o.out.empty() || !o.plot.empty();
+  eo.outlier_gate = o.outlier_gate;
+  eo.sampling = &rec.sampling;
+  eo.rows_skipped = rec.skipped_rows();
+  eo.first_skipped_line = rec.data.first_skipped_line;
+  const ArrayEstimate e = estimate_arrays(src, rec.t(), rec.v(), rec.y(), eo);
+  const EstimationRun& run = e.run.run;
   if (o.timing)
     fmt::print(stderr, "lash estimate: estimator ran {} samples in {} s ({:.3g} M samples/s)\n", rec.v().size(),
-               format_double(elapsed_s), static_cast<double>(rec.v().size()) / elapsed_s * 1e-6);
-  add_intervals(run, ar.cfg, rec.v(), rec.y(), rec.gap_rows());
+               format_double(e.estimator_s), static_cast<double>(rec.v().size()) / e.estimator_s * 1e-6);
   const auto& t = rec.t();
-  const double t1 = job.nrmse_t1_s < 0 ? t.back() : job.nrmse_t1_s;
-  const double fit = nrmse(t, rec.y(), run.ysim, job.nrmse_t0_s, t1);
-
   if (o.print_config) {
-    fmt::print("{}", config_to_toml(ar.cfg, &job));
+    fmt::print("{}", config_to_toml(e.run.cfg, &e.job));
     return kExitOk;
   }
-  if (!o.out.empty()) {
-    std::vector<std::string> names{"t", "y", "yhat", "y_sim"};
-    std::vector<const std::vector<double>*> cols{&t, &rec.y(), &run.yhat, &run.ysim};
-    for (std::size_t p = 0; p < run.param_names.size(); ++p) {
-      names.push_back(run.param_names[p]);
-      cols.push_back(&run.params[p]);
-    }
-    write_columns_csv(o.out, names, cols);
+  // the trace: t, y, yhat, y_sim and every parameter per step
+  std::vector<std::string> names{"t", "y", "yhat", "y_sim"};
+  std::vector<const std::vector<double>*> cols{&t, &rec.y(), &run.yhat, &run.ysim};
+  for (std::size_t p = 0; p < run.param_names.size(); ++p) {
+    names.push_back(run.param_names[p]);
+    cols.push_back(&run.params[p]);
   }
+  if (!o.out.empty()) write_columns_csv(o.out, names, cols);
   if (!o.plot.empty()) {
     std::string csv = o.out;
     std::filesystem::path tmp;
     if (csv.empty()) {
       tmp = std::filesystem::temp_directory_path() / ("lash-estimate-" + std::to_string(::getpid()) + ".csv");
       csv = tmp.string();
-      std::vector<std::string> names{"t", "y", "yhat", "y_sim"};
-      std::vector<const std::vector<double>*> cols{&t, &rec.y(), &run.yhat, &run.ysim};
-      for (std::size_t p = 0; p < run.param_names.size(); ++p) {
-        names.push_back(run.param_names[p]);
-        cols.push_back(&run.params[p]);
-      }
       write_columns_csv(csv, names, cols);
     }
     try {
       plot_estimate(csv, o.plot,
-                    fmt::format("lash estimate --model {} {}", to_string(cfg.model),
+                    fmt::format("lash estimate --model {} {}", to_string(e.run.cfg.model),
                                 std::filesystem::path(o.data).filename().string()),
                     run.param_names, t.back(), ci95_columns(run.report));
     } catch (...) {
@@ -102,12 +92,10 @@ int run(const CLI::App& sub, const EstimateOptions& o) {
     if (!tmp.empty()) std::filesystem::remove(tmp);
   }
 
-  const ReportFit rf{fit, job.nrmse_t0_s, t1, rec.skipped_rows(), rec.data.first_skipped_line, rec.gap_rows().size(),
-                     rec.sampling.median_dt};
   if (o.json)
-    fmt::print("{}\n", estimate_auto_json(ar, set.preset, rf));
+    fmt::print("{}\n", e.json);
   else
-    fmt::print("{}", estimate_auto_text(ar, rec.dt_s, rf));
+    fmt::print("{}", estimate_auto_text(e.run, e.result.dt_s, e.fit));
   return kExitOk;
 }
 

@@ -48,6 +48,8 @@ void add_scenario(CLI::App* sub, CommonOptions& o) {
       ->each([&o](const std::string&) { o.compensation_given = true; });
 }
 
+void add_controller(CLI::App* sub, CommonOptions& o) { add_controller_options(sub, o.controller, false); }
+
 CLI::Option* add_duration(CLI::App* sub, double& value, const std::string& what) {
   const double max_s = static_cast<double>(hil::kMaxSteps) * 5e-3;
   return sub
@@ -73,6 +75,12 @@ hil::BenchSettings load_settings(const CommonOptions& o) {
   }
   if (o.compensation_given && o.scenario.empty())
     throw InputError("", 0, "--compensation", "needs --scenario (the bench's own controller has its fixed offset)");
+  if (!o.controller.empty()) {
+    if (!o.scenario.empty())
+      throw InputError("", 0, std::string("--") + o.controller.front().field->flag,
+                       "with --scenario the scenario's [controller] table sets the controller");
+    apply_controller_overrides(s.controller, o.controller);
+  }
   if (!o.scenario.empty()) {
     const experiments::ClosedLoopScenario sc = experiments::load_closed_loop_scenario(o.scenario);
     if (o.step_ms != 0.0 && std::fabs(o.step_ms * 1e-3 - sc.dt_s) > 1e-9 * sc.dt_s)

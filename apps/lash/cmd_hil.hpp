@@ -3,6 +3,7 @@
 #include <string>
 
 #include "cli_common.hpp"
+#include "controller_options.hpp"
 #include "lash/hil/node_run.hpp"
 #include "lash/hil/settings.hpp"
 
@@ -23,12 +24,16 @@ struct CommonOptions {
   std::string scenario;                  // --scenario: a closed-loop scenario on the bench
   std::string compensation = "adaptive"; // --compensation (with --scenario)
   bool compensation_given = false;
+  std::vector<ControllerOverride> controller;  // --kp, --ki-per-s, … (after the settings' controller)
 };
 
 void add_common(CLI::App* sub, CommonOptions& o);
 /// --scenario FILE.toml and --compensation none|fixed|adaptive (run, simulate, slave, master).
 void add_scenario(CLI::App* sub, CommonOptions& o);
-/// The settings file (default config/hil/bench.toml) with --bus, --step-ms and --scenario applied.
+/// --kp, --ki-per-s, … (master, slave, run, simulate): the controller after the settings file.
+void add_controller(CLI::App* sub, CommonOptions& o);
+/// The settings file (default config/hil/bench.toml) with --bus, --step-ms, the controller
+/// overrides and --scenario applied.
 hil::BenchSettings load_settings(const CommonOptions& o);
 /// Validated loop options (InputError naming the option).
 hil::LoopOptions loop_options(const CommonOptions& o, const hil::BenchSettings& s);

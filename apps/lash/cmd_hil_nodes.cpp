@@ -172,6 +172,7 @@ void add_hil_nodes(CLI::App* hil, std::function<int()>& run_selected) {
   auto* slave = hil->add_subcommand("slave", "Slave ECU + pilot-valve plant emulator");
   add_common(slave, so->common);
   add_scenario(slave, so->common);
+  add_controller(slave, so->common);
   add_duration(slave, so->duration, "Longest run (log buffer size); stops earlier on SIGINT/SIGTERM/SIGHUP");
   slave->add_option("--log", so->log, "Per-step CSV log");
   slave->add_option("--stats", so->stats, "Statistics JSON");
@@ -184,6 +185,7 @@ void add_hil_nodes(CLI::App* hil, std::function<int()>& run_selected) {
   auto* master = hil->add_subcommand("master", "Master ECU: CCP connect, then PID + deadzone inverse + saturation");
   add_common(master, mo->common);
   add_scenario(master, mo->common);
+  add_controller(master, mo->common);
   add_duration(master, mo->duration, "Control time after the CCP handshake");
   master->add_option("--reference", mo->reference,
                      "KIND:key=value,... ; step:from=,to=,time= | square|sine|triangle:amplitude=,offset=,"

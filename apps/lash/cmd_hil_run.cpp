@@ -129,6 +129,7 @@ int run_run(const RunOptions& o) {
     if (!o.duration_given) so.duration_s = so.settings.scenario->duration_s;
     so.node_args = {"--scenario", o.common.scenario, "--compensation", o.common.compensation};
   }
+  for (auto& a : controller_option_args(o.common.controller)) so.node_args.push_back(std::move(a));
   so.reference = o.reference;
   so.out_dir = o.out_dir;
   so.isolate = !o.no_isolate;
@@ -158,6 +159,7 @@ int run_simulate(const SimulateOptions& o) {
   co.scenario = o.scenario.scenario;
   co.compensation = o.scenario.compensation;
   co.compensation_given = o.scenario.compensation_given;
+  co.controller = o.scenario.controller;
   hil::BenchSettings s = load_settings(co);
   const double duration = s.scenario && !o.duration_given ? s.scenario->duration_s : o.duration;
   if (o.seed >= 0) s.plant.seed = static_cast<std::uint64_t>(o.seed);
@@ -168,7 +170,7 @@ int run_simulate(const SimulateOptions& o) {
   hil::SimulationResult sim;
   if (o.schedule.empty()) {
     N = hil::steps_for(duration, s.step_s, "--duration");
-    sim = hil::simulate_bench(L, mc, sc, N);
+    sim = hil::simulate_bench(L, mc, sc, hil::ideal_schedule(N));
   } else {  // the run's own schedule: as many control steps as master.csv holds
     const std::filesystem::path mpath(o.schedule);
     const std::filesystem::path spath =
@@ -213,6 +215,7 @@ void add_hil_run(CLI::App* hil, std::function<int()>& run_selected) {
   add_duration(run, ro->duration, "Control time (with --scenario: the scenario's duration_s)")
       ->each([ro](const std::string&) { ro->duration_given = true; });
   add_scenario(run, ro->common);
+  add_controller(run, ro->common);
   run->add_option("--reference", ro->reference, "Reference (see `lash hil master --help`)");
   run->add_option("--out-dir", ro->out_dir, "Where the logs go (the files of a run are replaced, never mixed)");
   run->add_option("--seed", ro->seed, "Noise seed of the plant (-1 = from the settings)")
@@ -234,6 +237,7 @@ void add_hil_run(CLI::App* hil, std::function<int()>& run_selected) {
   add_duration(sim, sio->duration, "Control time (with --scenario: the scenario's duration_s)")
       ->each([sio](const std::string&) { sio->duration_given = true; });
   add_scenario(sim, sio->scenario);
+  add_controller(sim, sio->scenario);
   sim->add_option("--reference", sio->reference, "Reference (see `lash hil master --help`)");
   sim->add_option("--seed", sio->seed, "Noise seed of the plant (-1 = from the settings)")
       ->check(CLI::Range(std::int64_t{-1}, INT64_MAX));

@@ -67,16 +67,35 @@ def run_serial(files):
     return [row for f in files for row in identify(f)]
 
 
+# Dask's nanny starts every worker process with MALLOC_TRIM_THRESHOLD_=65536 (distributed.yaml,
+# nanny.pre-spawn-environ), and setting it turns glibc's adaptive mmap threshold off: every block
+# above 128 KiB (a 200 s record's columns, lash's per-sample arrays) is then a fresh mmap whose
+# pages fault in zeroed on first touch. lash.estimate of one 40 000-sample record took 3x the CPU
+# time in such a worker as in the client (docs/python.md). With these two, blocks up to 16 MiB come
+# from the heap again, which is still trimmed beyond 32 MiB free. For workers started by hand
+# (dask-worker, dask-ssh, Slurm), set the same two variables in their environment.
+WORKER_ENV = {"MALLOC_MMAP_THRESHOLD_": "16777216", "MALLOC_TRIM_THRESHOLD_": "33554432"}
+
+
+def local_cluster(workers=None):
+    """A LocalCluster of `workers` processes (default one per core), one thread each, WORKER_ENV set."""
+    import dask
+    from dask.distributed import LocalCluster
+
+    with dask.config.set({"distributed.nanny.pre-spawn-environ." + k: v for k, v in WORKER_ENV.items()}):
+        return LocalCluster(n_workers=workers or os.cpu_count(), threads_per_worker=1, processes=True,
+                            dashboard_address=None)
+
+
 def run_dask(files, scheduler=None, workers=None):
     """Identifies every file on a Dask cluster; rows in file order whatever the scheduling."""
-    from dask.distributed import Client, LocalCluster
+    from dask.distributed import Client
 
     cluster = None
     if scheduler:
         client = Client(scheduler)
     else:
-        cluster = LocalCluster(n_workers=workers or os.cpu_count(), threads_per_worker=1, processes=True,
-                               dashboard_address=None)
+        cluster = local_cluster(workers)
         client = Client(cluster)
     try:
         return identify_on(client, files)

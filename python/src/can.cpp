@@ -47,7 +47,11 @@ pyb::dtype log_dtype() {
 }
 
 pyb::array read_log(const std::string& path) {
-  const auto entries = can::read_log(path);
+  std::vector<can::LogEntry> entries;
+  {
+    pyb::gil_scoped_release nogil;  // reading and parsing the file touches no Python object
+    entries = can::read_log(path);
+  }
   pyb::array out(log_dtype(), std::vector<pyb::ssize_t>{static_cast<pyb::ssize_t>(entries.size())}, nullptr);
   auto* rows = static_cast<LogRow*>(out.mutable_data());
   for (std::size_t i = 0; i < entries.size(); ++i) {

@@ -1,6 +1,6 @@
 // lash.estimate, lash.Estimator, lash.Result, lash.read_record: conversion only; the work is
-// lash::run_estimator / add_intervals / score_estimate / to_json (= estimate_json), the calls
-// `lash estimate` makes.
+// lash::estimate_arrays (lash.estimate) and lash::run_estimator / add_intervals / score_estimate /
+// to_json (lash.Estimator), the calls `lash estimate` makes.
 #include <cmath>
 #include <memory>
 #include <optional>
@@ -18,19 +18,17 @@ namespace lash::py {
 
 namespace {
 
-/// The settings as `lash estimate` resolves them (lash::resolve_settings): the preset's, those chosen
-/// from the record (preset lash, when v and y are given), then the keyword arguments as the keys of an
-/// estimator config file (docs/identification.md); a key the model does not read is refused.
-EstimateSettings configure(const std::string& model, const std::string& preset, double dt_s,
-                           const pyb::dict& settings, std::span<const double> v = {}, std::span<const double> y = {}) {
+/// The sources of the settings as `lash estimate` resolves them (lash::resolve_settings): the
+/// preset's, those chosen from the record (preset lash, when v and y are given), then the keyword
+/// arguments `tbl` as the keys of an estimator config file (docs/identification.md); a key the
+/// model does not read is refused.
+SettingsSources sources(const std::string& model, const std::string& preset, const toml::table& tbl) {
   SettingsSources src;
   src.model = checked("model", [&] { return parse_model_kind(model); });
   src.preset = checked("preset", [&] { return parse_preset(preset); });
-  const toml::table tbl = to_toml(settings);
   src.keys = &tbl;
-  return resolve_settings(src, dt_s, v, y);
+  return src;
 }
-
 
 struct Result {
   EstimateResult res;
@@ -49,7 +47,8 @@ class Estimator {
  public:
   Estimator(const std::string& model, double dt_s, const std::string& preset, const pyb::kwargs& settings) {
     if (!(dt_s > 0) || !std::isfinite(dt_s)) throw InputError("", 0, "dt", "must be a finite number > 0 [s]");
-    EstimateSettings set = configure(model, preset, dt_s, settings);
+    const toml::table tbl = to_toml(settings);
+    EstimateSettings set = resolve_settings(sources(model, preset, tbl), dt_s);
     cfg_ = set.cfg;
     job_ = set.job;
     est_ = std::make_unique<AnyEstimator>(cfg_);
@@ -79,10 +78,15 @@ class Estimator {
   }
 
   Result result(bool intervals) const {
-    EstimationRun run;
-    run.report = est_->report();
-    if (intervals) add_intervals(run, cfg_, v_, y_);
-    return Result(score_estimate(run.report, cfg_.dt_s, job_, t_, y_, ysim_));
+    std::optional<EstimateResult> res;
+    {
+      pyb::gil_scoped_release nogil;  // the intervals run the estimator once more over the samples
+      EstimationRun run;
+      run.report = est_->report();
+      if (intervals) add_intervals(run, cfg_, v_, y_);
+      res.emplace(score_estimate(run.report, cfg_.dt_s, job_, t_, y_, ysim_));
+    }
+    return Result(std::move(*res));
   }
 
   void reset() {
@@ -133,43 +137,41 @@ class Estimator {
 Result estimate(const pyb::handle& t_obj, const pyb::handle& v_obj, const pyb::handle& y_obj, const std::string& model,
                 const std::string& preset, double outlier_gate, bool trace, bool intervals,
                 const pyb::kwargs& settings) {
-  configure(model, preset, 0.0, settings);  // settings are checked before the data is looked at
+  const toml::table tbl = to_toml(settings);
+  const SettingsSources src = sources(model, preset, tbl);
+  resolve_settings(src);  // settings are checked before the data is converted
   const Doubles ta(t_obj, "t"), va(v_obj, "v"), ya(y_obj, "y");
   va.require_length_of(ta);
   ya.require_length_of(ta);
-  const auto t = ta.span(), v = va.span(), y = ya.span();
-  sample_period(t, "", {}, "t");  // checks t (strictly increasing, at least 3 samples)
-  // as load_record: dt is the mean step without the gaps, and the estimator restarts at each gap
-  const Sampling smp = analyse_sampling(t);
-  const double dt = smp.dt;
-  const EstimateSettings set = configure(model, preset, dt, settings, v, y);
-  std::optional<AutoRun> ar;
-  std::optional<EstimateResult> res;
+  ArrayEstimateOptions o;
+  o.trace = trace;
+  o.outlier_gate = outlier_gate;
+  o.intervals = intervals;
+  std::optional<ArrayEstimate> e;
   {
-    pyb::gil_scoped_release nogil;
-    ar.emplace(estimate_auto(set.cfg, v, y, trace, outlier_gate, smp.gap_rows));
-    if (intervals) add_intervals(ar->run, ar->cfg, v, y, smp.gap_rows);
-    res.emplace(score_estimate(ar->run.report, dt, set.job, t, y, ar->run.ysim));
+    pyb::gil_scoped_release nogil;  // the whole library call: no Python object is touched
+    e.emplace(estimate_arrays(src, ta.span(), va.span(), ya.span(), o));
   }
-  EstimationRun* run = &ar->run;
-  ReportFit fit = report_fit(*res);  // as the CLI's: gaps and the median step of t too
-  fit.gaps = smp.gap_rows.size();
-  fit.median_dt_s = smp.median_dt;
-  std::string json = estimate_auto_json(*ar, set.preset, fit);
-  Result r(std::move(*res), std::move(json));
-  r.yhat = to_numpy(std::move(run->yhat));
-  r.ysim = to_numpy(std::move(run->ysim));
+  EstimationRun& run = e->run.run;
+  Result r(std::move(e->result), std::move(e->json));
+  r.yhat = to_numpy(std::move(run.yhat));
+  r.ysim = to_numpy(std::move(run.ysim));
   if (trace) {
     pyb::dict p;
-    for (std::size_t i = 0; i < run->param_names.size(); ++i)
-      p[pyb::str(run->param_names[i])] = to_numpy(std::move(run->params[i]));
+    for (std::size_t i = 0; i < run.param_names.size(); ++i)
+      p[pyb::str(run.param_names[i])] = to_numpy(std::move(run.params[i]));
     r.params = p;
   }
   return r;
 }
 
 pyb::dict read_record(const std::string& path, const std::vector<std::string>& columns) {
-  Record rec = load_record(path, columns);
+  std::optional<Record> loaded;
+  {
+    pyb::gil_scoped_release nogil;  // reading and parsing the file touches no Python object
+    loaded.emplace(load_record(path, columns));
+  }
+  Record& rec = *loaded;
   pyb::dict d;
   d["file"] = rec.data.file;
   d["dt_s"] = rec.dt_s;

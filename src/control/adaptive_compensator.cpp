@@ -123,8 +123,11 @@ PerSide<GateInput> DeadzoneAdapter::step(double v_applied, double y) noexcept {
   const double v1 = v1_;
   v1_ = v_applied;
   est_.step(v_applied, y);
-  if (v1 > ecfg_.guess_right) exc_r_.add(v1);
-  else if (v1 < ecfg_.guess_left) exc_l_.add(v1);
+  if (warm_ > 0 && std::isfinite(v_applied) && std::isfinite(y)) --warm_;  // as the estimator's warm-up
+  if (warm_ == 0) {
+    if (v1 > ecfg_.guess_right) exc_r_.add(v1);
+    else if (v1 < ecfg_.guess_left) exc_l_.add(v1);
+  }
   const SideParams r = est_.params(Side::right), l = est_.params(Side::left);
   const bool ex_r = exc_r_.var >= need_.right * need_.right;  // std ≥ need, without a square root
   const bool ex_l = exc_l_.var >= need_.left * need_.left;

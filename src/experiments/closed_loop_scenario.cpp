@@ -4,8 +4,9 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "lash/control/controller_fields.hpp"
 #include "lash/hil/node_run.hpp"
-#include "lash/hil/simulate.hpp"
+#include "lash/hil/schedule.hpp"
 #include "lash/identify/config_file.hpp"
 #include "lash/io/error.hpp"
 #include "lash/io/toml_util.hpp"
@@ -34,35 +35,18 @@ void read_reference(TomlTable& in, SignalSpec& s) {
 }
 
 void read_controller(TomlTable& c, ClosedLoopScenario& s) {
-  auto nonneg = [&](std::string_view key, double fallback) {
-    const double v = c.number_or(key, fallback);
-    if (!(v >= 0)) c.fail(key, "must be >= 0");
-    return v;
-  };
-  s.pid.gains.kp = nonneg("kp", 0.0);
-  s.pid.gains.ki_per_s = nonneg("ki", 0.0);
-  s.pid.gains.kd_s = nonneg("kd", 0.0);
-  s.pid.gains.n_per_s = nonneg("n", 0.0);
-  if (auto m = c.string_opt("integrator")) {
-    try {
-      s.pid.integrator = parse_integrator_method(m->c_str());
-    } catch (const std::invalid_argument& e) {
-      c.fail("integrator", e.what());
-    }
-  }
-  if (auto aw = c.string_opt("anti_windup")) {
-    if (*aw == "none") s.pid.anti_windup = AntiWindup::none;
-    else if (*aw == "clamp") s.pid.anti_windup = AntiWindup::clamp;
-    else c.fail("anti_windup", "must be \"none\" or \"clamp\"");
-  }
+  for (const char* k : {"dt_s", "dt"})
+    if (c.has(k)) c.fail(k, "the controller runs at the scenario's dt_s; remove it here");
   s.feedforward = c.number_or("feedforward", 0.0);
   s.command_min = c.number_or("min", s.command_min);
   s.command_max = c.number_or("max", s.command_max);
   if (!(s.command_min <= s.command_max)) c.fail("max", "needs min <= max (the rig input's saturation)");
-  s.pid.output_min = c.number_or("output_min", s.command_min);
-  s.pid.output_max = c.number_or("output_max", s.command_max);
-  if (!(s.pid.output_min <= s.pid.output_max)) c.fail("output_max", "needs output_min <= output_max");
-  if (c.has("dt")) c.fail("dt", "the controller runs at the scenario's dt_s; remove dt here");
+  // The PID: the [pid] keys of a gains file (control/controller_fields.hpp; ki, kd, n are the
+  // deprecated aliases of ki_per_s, kd_s, n_per_s), in the rig's units; the anti-windup limits
+  // default to the saturation.
+  s.pid.output_min = s.command_min;
+  s.pid.output_max = s.command_max;
+  read_pid_fields(c, s.pid);
   c.finish();
 }
 
@@ -341,7 +325,7 @@ ClosedLoopScenarioResult run_closed_loop_scenario(const ClosedLoopScenario& s, C
     apply_to_bench(s, mode, b);
     const hil::BenchLayout L;  // the layout of config/hydraulic_bench.dbc
     const hil::SimulationResult sim =
-        hil::simulate_bench(L, hil::master_config(b, ""), hil::slave_config(b, L), n);
+        hil::simulate_bench(L, hil::master_config(b, ""), hil::slave_config(b, L), hil::ideal_schedule(n));
     for (std::size_t m = 0; m < n && m + 1 < sim.master.size() && m < sim.slave.size(); ++m) {
       const auto& ml = sim.master[m + 1];  // master row 0 is the CONNECT step
       record(res.trace, static_cast<double>(m) * dt, ml.reference_kPa, sim.slave[m].pressure_kPa, ml.current_mA,
@@ -382,7 +366,7 @@ ClosedLoopScenarioResult run_closed_loop_scenario(const ClosedLoopScenario& s, C
       const double ff = s.feedforward * (wstar - wstar1) / dt;  // velocity feedforward
       wstar1 = wstar;
       const double v = clamp(pid.step(wstar - w) + ff, s.command_min, s.command_max);
-      comp.observe(w, y);
+      comp.observe(w, y, true);  // simulated: every sample fresh
       const PerSide<double> used = comp.in_use();
       record(res.trace, t, r, y, v, used.right, used.left);
       res.trace.drive.push_back(w);

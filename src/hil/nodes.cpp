@@ -380,7 +380,8 @@ double MasterNode::law(double r, double y) noexcept {
   const double u = pid_->step(r - y) + c.feedforward * r;
   double i = comp_->command(u);
   i = i < c.command_min ? c.command_min : (i > c.command_max ? c.command_max : i);
-  comp_->observe(i, y);
+  comp_->observe(i, y, true);  // law() runs on a fresh sensor value only (control())
+  law_ran_ = true;
   return i;
 }
 
@@ -409,6 +410,16 @@ CompensationState MasterNode::compensation() const noexcept {
 
 // One control step in states connected..safe: sets current_mA_.
 void MasterNode::control(can::Bus& bus, double r, double now_s) noexcept {
+  law_ran_ = false;
+  control_states(bus, r, now_s);
+  // A control step whose law did not run on a fresh sensor value (a late frame: the command is
+  // held; degraded, safe, not yet running) is a gap for the adaptive compensator: the
+  // estimator is restarted and not updated, the inverse keeps its parameters
+  // (DeadzoneCompensator::observe with fresh = false, docs/compensation.md).
+  if (comp_ && !law_ran_) comp_->observe(current_mA_, measured_kPa_, false);
+}
+
+void MasterNode::control_states(can::Bus& bus, double r, double now_s) noexcept {
   const double safe_mA = cfg_.controller.current_min_mA;
   const bool stale = watch_.misses >= cfg_.fault_missed_periods;
   const bool recovered = watch_.good_run >= cfg_.e2e.recovery_frames;

@@ -156,7 +156,7 @@ SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& m
   SlaveNode slave(layout, sc);
   const double T = mc.controller.pid.dt_s;
   FeedBus mb, sb;
-  // Handshake as in simulate_bench: CRO → slave, DTO → master.
+  // Handshake: CRO → slave, DTO → master.
   master.step(mb, 0.0);
   sb.in.assign(mb.out.begin(), mb.out.end());
   mb.out.clear();
@@ -199,6 +199,9 @@ SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& m
   }
   // The slave steps of the control steps run (for the plant pressure of each control step).
   while (s < static_cast<std::int64_t>(N) && slave_ready()) slave_step();
+  if (N > 0 && (master.state() == MasterState::startup || master.state() == MasterState::failed))
+    throw std::invalid_argument(std::string("hil simulate: the master ended in state ") + to_string(master.state()) +
+                                " (is the recorded DTO a positive CONNECT reply?)");
 
   SimulationResult r;
   r.master.assign(master.log().begin(), master.log().end());

@@ -328,7 +328,7 @@ RunReport Session::run(const std::function<void(const std::string&)>& progress) 
 
   std::vector<MasterStepLog> simulated;
   if (have_master && mrun.stats.control_steps > 0)
-    simulated = simulate_bench(L, mc, sc, static_cast<std::size_t>(mrun.stats.control_steps)).master;
+    simulated = simulate_bench(L, mc, sc, ideal_schedule(static_cast<std::size_t>(mrun.stats.control_steps))).master;
   make_run_report(rep, have_master ? &mrun : nullptr, sruns, simulated,
                   o_.settings.scenario ? &*o_.settings.scenario : nullptr);
   if (!simulated.empty()) {  // the same closed loop, fed the frames each node logged it used

@@ -54,35 +54,4 @@ MemLink::MemLink() {
   b_ = std::make_unique<LinkEnd>(ab, ba);
 }
 
-SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& master_cfg,
-                                const SlaveConfig& slave_cfg, std::size_t control_steps) {
-  MasterConfig mc = master_cfg;
-  mc.log_capacity = control_steps + 1;
-  SlaveConfig sc = slave_cfg;
-  sc.log_capacity = control_steps;
-  MasterNode master(layout, mc);
-  SlaveNode slave(layout, sc);
-  MemLink link;
-  const double T = mc.controller.pid.dt_s;
-  std::size_t k = 0;
-  master.step(link.a(), 0.0);  // sends CRO
-  if (!slave.wait_connect(link.b(), std::chrono::nanoseconds(0)))
-    throw std::invalid_argument("hil simulate: the slave did not see the master's CCP CONNECT");
-  for (std::size_t s = 0; s < control_steps; ++s) {
-    ++k;
-    const double t = static_cast<double>(k) * T;
-    slave.step(link.b(), t - 0.5 * T);
-    if (!master.step(link.a(), t)) break;
-  }
-  if (master.state() != MasterState::running)
-    throw std::invalid_argument(std::string("hil simulate: the master ended in state ") + to_string(master.state()) +
-                                " (is the recorded DTO a positive CONNECT reply?)");
-  SimulationResult r;
-  r.master.assign(master.log().begin(), master.log().end());
-  r.slave.assign(slave.log().begin(), slave.log().end());
-  r.events.assign(master.events().begin(), master.events().end());
-  r.compensation = master.compensation();
-  return r;
-}
-
 }  // namespace lash::hil

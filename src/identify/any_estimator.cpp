@@ -105,14 +105,14 @@ EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> 
   AnyEstimator est(cfg);
   EstimationRun run;
   const std::size_t n = v.size();
-  run.yhat.resize(n);
-  run.ysim.resize(n);
+  run.yhat.reserve(n);  // filled in step order below: no zero-filling pass over 2 x n doubles first
+  run.ysim.reserve(n);
   run.param_names = est.param_names();
   std::vector<double> pv(run.param_names.size());
   if (keep_trace) run.params.assign(pv.size(), std::vector<double>(n));
   step_through(est, v, y, 0, n, gap_rows, [&](std::size_t k) {
-    run.yhat[k] = est.prediction();
-    run.ysim[k] = est.simulated();
+    run.yhat.push_back(est.prediction());  // k = run.yhat.size(): step_through goes 0, 1, ..., n - 1
+    run.ysim.push_back(est.simulated());
     if (keep_trace) {
       est.param_values(pv);
       for (std::size_t p = 0; p < pv.size(); ++p) run.params[p][k] = pv[p];

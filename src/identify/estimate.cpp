@@ -1,5 +1,7 @@
 #include "lash/identify/estimate.hpp"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "lash/io/csv.hpp"
@@ -29,18 +31,55 @@ EstimatorConfig config_for_record(EstimatorConfig cfg, const EstimationJob& job,
 }
 
 EstimateResult score_estimate(const EstimateReport& report, double dt_s, const EstimationJob& job,
-                              std::span<const double> t, std::span<const double> y, std::span<const double> ysim) {
+                              std::span<const double> t, std::span<const double> y, std::span<const double> ysim,
+                              bool t_increasing) {
   EstimateResult r;
   r.report = report;
   r.dt_s = dt_s;
   r.nrmse_t0_s = job.nrmse_t0_s;
   r.nrmse_t1_s = job.nrmse_t1_s < 0 ? (t.empty() ? 0.0 : t.back()) : job.nrmse_t1_s;
-  r.nrmse = nrmse(t, y, ysim, r.nrmse_t0_s, r.nrmse_t1_s);
+  if (t_increasing) {
+    const std::size_t n = std::min({t.size(), y.size(), ysim.size()});
+    const auto t_n = t.first(n);
+    const auto k0 = static_cast<std::size_t>(std::lower_bound(t_n.begin(), t_n.end(), r.nrmse_t0_s) - t_n.begin());
+    const auto k1 = static_cast<std::size_t>(std::upper_bound(t_n.begin(), t_n.end(), r.nrmse_t1_s) - t_n.begin());
+    r.nrmse = nrmse(y.subspan(k0, k1 > k0 ? k1 - k0 : 0), ysim.subspan(k0, k1 > k0 ? k1 - k0 : 0));
+  } else {
+    r.nrmse = nrmse(t, y, ysim, r.nrmse_t0_s, r.nrmse_t1_s);
+  }
   return r;
 }
 
 ReportFit report_fit(const EstimateResult& r) noexcept { return ReportFit{r.nrmse, r.nrmse_t0_s, r.nrmse_t1_s}; }
 
 std::string to_json(const EstimateResult& r) { return estimate_json(r.report, report_fit(r)); }
+
+ArrayEstimate estimate_arrays(const SettingsSources& src, std::span<const double> t, std::span<const double> v,
+                              std::span<const double> y, const ArrayEstimateOptions& o) {
+  resolve_settings(src);  // settings are checked before the data is looked at
+  for (const auto& [name, col] : {std::pair{"v", v}, std::pair{"y", y}})
+    if (col.size() != t.size())
+      throw InputError("", 0, name,
+                       "has " + std::to_string(col.size()) + " samples, t has " + std::to_string(t.size()));
+  sample_period(t);  // t: at least 3 samples, strictly increasing
+  ArrayEstimate out;
+  out.sampling = o.sampling ? *o.sampling : analyse_sampling(t);
+  const Sampling& smp = out.sampling;
+  const EstimateSettings set = resolve_settings(src, smp.dt, v, y);
+  out.preset = set.preset;
+  out.job = set.job;
+  const auto t_start = std::chrono::steady_clock::now();
+  out.run = estimate_auto(set.cfg, v, y, o.trace, o.outlier_gate, smp.gap_rows);
+  out.estimator_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  if (o.intervals) add_intervals(out.run.run, out.run.cfg, v, y, smp.gap_rows);
+  out.result = score_estimate(out.run.run.report, smp.dt, set.job, t, y, out.run.run.ysim, true);
+  out.fit = report_fit(out.result);  // with what the reader found: skipped rows, gaps, median step of t
+  out.fit.rows_skipped = o.rows_skipped;
+  out.fit.first_skipped_line = o.first_skipped_line;
+  out.fit.gaps = smp.gap_rows.size();
+  out.fit.median_dt_s = smp.median_dt;
+  out.json = estimate_auto_json(out.run, set.preset, out.fit);
+  return out;
+}
 
 }  // namespace lash

@@ -51,6 +51,28 @@ write_cfg "" "$tmp/nodto.log"
 expect2 "nodto.log" hil simulate --config "$tmp/bench.toml" -o "$tmp/b.csv"
 [[ -e "$tmp/b.csv" ]] && fail "output written despite bad input"
 
+# Controller override flags (from the field table, after the settings' controller): bad values
+# exit 2 naming the flag; with --scenario refused; --dt-s is not one (the step is --step-ms).
+expect2 "'--kp'.*>= 0" hil simulate --kp -1 -o "$tmp/d.csv"
+expect2 "'--max-mA'.*min_mA <= max_mA" hil simulate --max-mA -5 -o "$tmp/d.csv"
+expect2 "'--anti-windup'" hil master --bus mem:x --anti-windup soft --log "$tmp/d.csv"
+expect2 "'--ki-per-s'.*scenario" hil simulate --ki-per-s 3 --scenario "$src/config/scenarios/closed_loop/valve_no_drift.toml" -o "$tmp/d.csv"
+expect2 "dt-s" hil simulate --dt-s 0.001 -o "$tmp/d.csv"
+[[ -e "$tmp/d.csv" ]] && fail "output written despite bad input"
+# Identity: a flag gives the same run as the same key in the gains file.
+sed -e 's/^kp = .*/kp = 0.9/' "$src/config/control/lash_gains.toml" >"$tmp/gains_kp.toml"
+grep -q "^kp = 0.9$" "$tmp/gains_kp.toml" || fail "lash_gains.toml changed: update this test"
+for g in "$src/config/control/lash_gains.toml" "$tmp/gains_kp.toml"; do
+  sed -e "s|^controller = .*|controller = \"$g\"|" -e "s|^dbc = .*|dbc = \"$src/config/hydraulic_bench.dbc\"|" \
+      -e "s|^dto_log = .*|dto_log = \"$src/config/hil/ccp_connect.log\"|" "$src/config/hil/bench.toml" >"$tmp/$(basename "$g").bench.toml"
+done
+"$LASH" hil simulate --config "$tmp/lash_gains.toml.bench.toml" --kp 0.9 --duration 2 -o "$tmp/flag.csv" 2>/dev/null || fail "hil simulate --kp failed"
+"$LASH" hil simulate --config "$tmp/gains_kp.toml.bench.toml" --duration 2 -o "$tmp/file.csv" 2>/dev/null || fail "hil simulate (kp in file) failed"
+"$LASH" hil simulate --config "$tmp/lash_gains.toml.bench.toml" --duration 2 -o "$tmp/base.csv" 2>/dev/null || fail "hil simulate failed"
+cmp -s "$tmp/flag.csv" "$tmp/file.csv" || fail "hil simulate --kp 0.9 differs from kp = 0.9 in the gains file"
+cmp -s "$tmp/flag.csv" "$tmp/base.csv" && fail "--kp 0.9 changed nothing"
+echo "ok: hil simulate --kp 0.9 = kp = 0.9 in the gains file (and differs from the shipped kp)"
+
 expect2 "--spin-us" hil master --bus mem:x --spin-us 5000 --log "$tmp/c.csv"
 expect2 "--spin-us" hil slave --bus mem:x --spin-us -1 --log "$tmp/c.csv"
 [[ -e "$tmp/c.csv" ]] && fail "log written despite bad input"

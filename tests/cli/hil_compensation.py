@@ -2,8 +2,9 @@
  - `lash hil simulate --scenario` and `lash hil run --scenario` on the valve drift scenario give the
    tracking figures of `lash closed-loop --scenario` on the same file (the same nodes run both);
    live: on every attempt 0 kPa from the simulation on the observed schedule; bit-identical when every step used its own frame
-   (off_schedule_steps == 0), up to three attempts on a busy host; the master's TET mean with
-   adaptation on is printed (a timing figure, not asserted);
+   (off_schedule_steps == 0); with a few late frames (<= 1 % of the steps) the RMS figures of the
+   windows without a safe-state episode within 20 % (the adaptive law holds on a stale sample); up to four attempts on a
+   busy host; the master's TET mean with adaptation on is printed (a timing figure, not asserted);
  - a coupled_carts scenario, or --compensation without --scenario, is refused with exit 2;
  - the default `lash hil run --duration 5` (live, two processes in the run's own network
    namespace): overshoot <= 10 % and, from 1 s after the step, the current's std <= 50 mA,
@@ -62,10 +63,27 @@ for mode in ("fixed", "adaptive"):
     want = f"rms error {t['rms_error']:.6g} kPa, max |error| {t['max_abs_error']:.6g} kPa"
     check(want in p.stdout, f"hil simulate {mode}: '{want}' as closed-loop")
 
-# Live: hil run on the drift scenario (40 s), bit-identical to closed-loop when no frame was off schedule.
+# Live: hil run on the drift scenario (40 s, 8000 steps). On every attempt the bench equals its
+# simulation on the schedule it observed (0 kPa). Then, against closed-loop (the ideal schedule):
+#  (b) no step off schedule: every tracking figure, the final inverse and the update count
+#      bit-identical;
+#  (c) a few late frames (off-schedule steps <= 1 % = 80): each figure whose window saw no
+#      safe-state episode (below) has its RMS within 20 % of closed-loop's and its max |error|
+#      within 2x. Justification (docs/compensation.md, scripts/late_frame_study.py): synthetic
+#      schedules with 40 to 80 late frames at random steps, replayed by lash hil simulate
+#      --schedule, gave RMS ratios 0.96..1.15 and max ratios 0.55..1.40 against closed-loop: a
+#      late frame holds the command for a step, and the adaptive law holds on it (the estimator
+#      is restarted, the inverse keeps its edges).
+#  A host stall of >= fault_missed_periods (3) steps sends the master to its safe state (0 mA,
+#  PI reset, docs/hil.md): a transient of up to ~370 kPa that is the safety rule's, not the
+#  law's. A window with such an episode in it (or in the 2 s before it) is not compared; the
+#  test tries again until the score window was compared on an attempt (or bit-identical).
+FEW = 80
+WINDOWS = {"tracking": (24.0, 40.0), "tracking_before_drift": (0.0, 20.0), "tracking_after_drift": (20.0, 40.0)}
 clean = None
+few = []
 tets = []
-for attempt in range(3):
+for attempt in range(4):
     out = tempfile.mkdtemp(prefix="lash_hil_comp_")
     r = subprocess.run([lash, "hil", "run", "--scenario", drift, "--compensation", "adaptive", "--json", *RT,
                         "--out-dir", out], capture_output=True, text=True, timeout=200)
@@ -73,10 +91,13 @@ for attempt in range(3):
     rep = json.loads(r.stdout)
     for k in ("tracking", "tracking_before_drift", "tracking_after_drift", "compensation", "adaptation"):
         assert k in rep, f"report has no {k}"
+    left_running = [e["event"] for e in rep["master"]["events"] if e["step"] > 1]
     print(f"attempt {attempt}: off-schedule {rep['off_schedule_steps']}, late {rep['frames']['late']}, lost "
-          f"{rep['frames']['lost']}, tracking {rep['tracking']}, after drift {rep['tracking_after_drift']['rms_error']}, "
-          f"final {rep['compensation']['final']}, updates {rep['adaptation']['updates']}, master TET mean "
-          f"{rep['master']['tet_us']['mean']:.3f} us")
+          f"{rep['frames']['lost']}, master events {left_running or 'none'}, tracking {rep['tracking']}, "
+          f"before drift {rep['tracking_before_drift']['rms_error']}, after drift "
+          f"{rep['tracking_after_drift']['rms_error']}, final {rep['compensation']['final']}, updates "
+          f"{rep['adaptation']['updates']}, master TET mean {rep['master']['tet_us']['mean']:.3f} us, wake latency "
+          f"max {rep['master']['wake_latency_us']['max']:.0f} us")
     check(rep["master"]["control_steps"] == 8000, "hil run: the scenario's 40 s at 5 ms")
     # Steps that consumed another frame than their own (hil_run.py): the traces may differ from
     # the simulation, but never before the first of them.
@@ -90,22 +111,33 @@ for attempt in range(3):
     if off and rep["max_abs_diff_vs_simulation_kPa"] > 0:
         check(min(off) <= rep["first_diff_control_step"],
               f"first difference (step {rep['first_diff_control_step']}) not before the first off-schedule step {min(off)}")
-    # Every run, late frames or not: the bench equals its simulation on the schedule it observed
-    # (hil simulate --schedule). The tracking figures themselves do depend on the schedule: late
-    # frames feed the adaptive law stale pressures (docs/compensation.md gives measured figures).
     check(rep["max_abs_diff_vs_observed_schedule_kPa"] == 0,
           f"hil run == its observed-schedule simulation ({rep['max_abs_diff_vs_observed_schedule_kPa']} kPa)")
     tets.append(rep["master"]["tet_us"]["mean"])
     if rep["off_schedule_steps"] == 0:
         clean = rep
         break
+    if rep["off_schedule_steps"] <= FEW:
+        safe_t = [(e["step"] - 1) * 0.005 for e in rep["master"]["events"] if e["event"] == "sensor_timeout_safe_state"]
+        for w, (t0, t1) in WINDOWS.items():
+            if any(t0 - 2.0 <= t < t1 for t in safe_t):
+                print(f"attempt {attempt}: {w} not compared (safe-state episode at {safe_t} s)")
+                continue
+            a, b = rep[w]["rms_error"], ref[w]["rms_error"]
+            check(abs(a / b - 1.0) <= 0.2, f"attempt {attempt} ({rep['off_schedule_steps']} off-schedule): {w}.rms_error "
+                  f"{a:.4g} within 20 % of closed-loop's {b:.4g} (ratio {a / b:.3f})")
+            a, b = rep[w]["max_abs_error"], ref[w]["max_abs_error"]
+            check(a <= 2.0 * b, f"attempt {attempt}: {w}.max_abs_error {a:.4g} <= 2 x closed-loop's {b:.4g}")
+            few.append(w)
+        if "tracking" in few:
+            break
 # The master's TET with adaptation on is a timing figure, reported here and in docs/compensation.md,
 # not asserted (a host stall or a build beside the test inflates it).
 print(f"master TET mean with adaptation on, best attempt: {min(tets):.3f} us (goal <= 5 us)")
-if clean is None:
-    print("live part: every attempt had off-schedule frames; bit-identity with closed-loop not checked "
-          "(the observed-schedule identity above was)")
-else:
+if clean is None and "tracking" not in few:
+    print("live part: every attempt had a host stall (safe state) in the score window or more than 1 % of the "
+          "steps off schedule; tracking against closed-loop not checked (the observed-schedule identity above was)")
+elif clean is not None:
     for k in ("rms_error", "max_abs_error"):
         check(clean["tracking"][k] == ref["tracking"][k],
               f"hil run tracking.{k} {clean['tracking'][k]} == closed-loop {ref['tracking'][k]}")
@@ -148,4 +180,4 @@ for f in fail:
     print("FAIL", f)
 if fail:
     sys.exit(1)
-sys.exit(0 if clean is not None and clean_default else hil_netns.SKIP)
+sys.exit(0 if (clean is not None or "tracking" in few) and clean_default else hil_netns.SKIP)

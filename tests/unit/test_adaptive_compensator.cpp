@@ -5,7 +5,12 @@
 
 #include "ref_backlash.hpp"
 
+#include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <type_traits>
+#include <vector>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -57,8 +62,8 @@ TEST(Compensator, NoneIsIdentityAndFixedIsTheNominalInverse) {
     EXPECT_EQ(bl_none.command(p), p);
     EXPECT_EQ(dz_fixed.command(u), dz_ref.step(u));
     EXPECT_EQ(bl_fixed.command(p), bl_ref.step(p));
-    dz_fixed.observe(u, 0.5 * u);  // not adaptive: the estimator is not stepped
-    bl_fixed.observe(p, p);
+    dz_fixed.observe(u, 0.5 * u, true);  // not adaptive: the estimator is not stepped
+    bl_fixed.observe(p, p, true);
   }
   EXPECT_EQ(dz_fixed.updates(), 0u);
   EXPECT_EQ(bl_fixed.updates(), 0u);
@@ -75,7 +80,7 @@ TEST(BacklashCompensator, AdaptsToUnequalGapsOfAReferenceBacklash) {
   RefBacklash b{0.004, 0.0065, -0.0065};
   for (int k = 0; k < 30000; ++k) {
     const double w = 0.05 * std::sin(2.0 * std::numbers::pi * k * kDt / 4.0);
-    comp.observe(w, b.step(w));
+    comp.observe(w, b.step(w), true);
   }
   EXPECT_TRUE(comp.adapter().identified(Side::right)) << comp.estimator_reason(Side::right);
   EXPECT_TRUE(comp.adapter().identified(Side::left)) << comp.estimator_reason(Side::left);
@@ -96,7 +101,7 @@ TEST(BacklashCompensator, NoReversalNoAdaptation) {
   RefBacklash b{0.005, 0.005, 0.0};
   for (int k = 0; k < 20000; ++k) {
     const double w = 0.03 + 0.002 * std::sin(2.0 * std::numbers::pi * k * kDt);  // ±2 mm: inside the 10 mm gap
-    comp.observe(w, b.step(w));
+    comp.observe(w, b.step(w), true);
   }
   EXPECT_EQ(comp.updates(), 0u);
   EXPECT_EQ(comp.inverse().params().right, 0.005);
@@ -111,4 +116,123 @@ TEST(BacklashCompensator, RefusesAShiftInsideTheGuesses) {
   c = carts(CompensationMode::adaptive);
   c.estimator.model = ModelKind::coupled_carts;
   EXPECT_THROW(BacklashCompensator{c}, std::invalid_argument);
+}
+
+// ---------------------------------------------------------------- stale samples (observe, fresh = false)
+namespace {
+std::uint64_t bits(double x) { return std::bit_cast<std::uint64_t>(x); }
+// The estimator's state that a stale sample must leave alone, bit for bit: per side the verdict's
+// parameters, the RLS estimate, covariance and update count.
+template <class E>
+std::vector<std::uint64_t> estimator_state(const E& e) {
+  std::vector<std::uint64_t> v;
+  for (Side s : {Side::right, Side::left}) {
+    const SideParams p = e.params(s);
+    for (double x : {p.a1, p.b1, p.c, p.d}) v.push_back(bits(x));
+    v.push_back(p.identified);
+    v.push_back(static_cast<std::uint64_t>(p.reason));
+    v.push_back(e.updates(s));
+  }
+  auto rls = [&v](const auto& r) {
+    for (double x : r.eta()) v.push_back(bits(x));
+    for (const auto& row : r.P())
+      for (double x : row) v.push_back(bits(x));
+    v.push_back(r.updates());
+  };
+  if constexpr (std::is_same_v<E, DeadzoneDeadbandEstimator>) {
+    for (int k = 0; k < 4; ++k) rls(e.rls(static_cast<DeadzoneDeadbandEstimator::Key>(k)));
+    for (Side s : {Side::right, Side::left}) rls(e.pooled_rls(s));
+  } else {
+    for (Side s : {Side::right, Side::left}) rls(e.rls(s));
+  }
+  return v;
+}
+std::vector<std::uint64_t> inverse_state(const DeadzoneCompensator& c) {
+  const DeadzoneInverseParams p = c.inverse().params();
+  return {bits(p.offset_right), bits(p.offset_left), bits(c.gate(Side::right).value()),
+          bits(c.gate(Side::left).value()), c.updates()};
+}
+bool stale_step(int k) { return k % 97 == 41 || k % 1013 == 500 || k % 1013 == 501; }  // singles and pairs
+}  // namespace
+
+// A valve-like loop (first-order pressure, deadzone 288 → 380 mA at 30 s, uniform sensor noise)
+// with the master's rule on a late sensor frame: the command is held and the compensator told
+// the sample is stale. Each stale step leaves the estimator's estimates and the inverse bit-
+// unchanged; the estimator inside equals a bare InputDeadzoneEstimator driven by hand with the
+// same samples, restart() at each stale step instead of the sample (docs/compensation.md); and
+// treating those samples as fresh gives a different estimate (the test can fail).
+TEST(DeadzoneCompensator, StaleSamplesNeitherUpdateTheEstimatorNorMoveTheInverse) {
+  DeadzoneCompensationConfig cfg = valve(CompensationMode::adaptive);
+  cfg.estimator.dt_s = 0.005;
+  cfg.estimator.method = EstimationMethod::iv;
+  cfg.estimator.rls.lambda = 0.995;
+  DeadzoneCompensator comp(cfg), all_fresh(cfg);
+  InputDeadzoneEstimator by_hand(cfg.estimator);
+  Rng rng(3);
+  double x = 0.0, y = 0.0, i = 0.0, integ = 0.0;
+  int stale = 0;
+  for (int k = 0; k < 12000; ++k) {
+    const double edge = k < 6000 ? 288.0 : 380.0;
+    const double r = 600.0 * std::sin(2.0 * std::numbers::pi * k * 0.005 / 4.0);
+    const bool fresh = !stale_step(k);
+    if (fresh) y = x + 20.0 * (rng.uniform() - 0.5);  // a stale step keeps the last value received
+    if (fresh) {  // PI + feedforward, then the compensator, as the master's scenario law
+      integ += 10.0 * 0.005 * (r - y);
+      i = std::clamp(comp.command(0.5 * (r - y) + integ + 0.465 * r), -2000.0, 2000.0);
+    }  // else: the command of the last step is held and y is the last value received
+    const auto est_before = estimator_state(comp.estimator());
+    const auto inv_before = inverse_state(comp);
+    comp.observe(i, y, fresh);
+    all_fresh.observe(i, y, true);
+    if (fresh) {
+      by_hand.step(i, y);
+    } else {
+      by_hand.restart();
+      ++stale;
+      ASSERT_EQ(estimator_state(comp.estimator()), est_before) << "stale step " << k;
+      ASSERT_EQ(inverse_state(comp), inv_before) << "stale step " << k;
+    }
+    ASSERT_EQ(estimator_state(comp.estimator()), estimator_state(by_hand)) << "step " << k;
+    const double dz = i > edge ? i - edge : (i < -296.0 ? i + 296.0 : 0.0);
+    x = 0.93 * x + 0.07 * 2.15 * dz;
+  }
+  EXPECT_EQ(comp.stale_samples(), static_cast<std::uint64_t>(stale));
+  EXPECT_GT(stale, 100);
+  // The loop adapted: the right edge moved from 288 towards the drifted 380 mA.
+  EXPECT_GT(comp.updates(), 0u);
+  EXPECT_GT(comp.inverse().params().offset_right, 340.0) << comp.estimator_reason(Side::right);
+  EXPECT_NE(estimator_state(comp.estimator()), estimator_state(all_fresh.estimator()));
+}
+
+// The carts' adapter regresses the driven position one sample late: after a stale sample the
+// next one only refills that delay (the estimator is stepped from the sample after it on).
+TEST(BacklashCompensator, StaleSamplesRestartTheEstimatorAndHoldTheInverse) {
+  BacklashCompensator comp(carts(CompensationMode::adaptive));
+  const auto cfg = carts(CompensationMode::adaptive).estimator;
+  DeadzoneDeadbandEstimator by_hand(cfg);
+  RefBacklash b{0.004, 0.0065, -0.0065};
+  double y1 = 0.0;
+  bool refill = false;
+  for (int k = 0; k < 30000; ++k) {
+    const double w = 0.05 * std::sin(2.0 * std::numbers::pi * k * kDt / 4.0);
+    const double y = b.step(w);
+    const bool fresh = !stale_step(k);
+    const auto before = estimator_state(comp.estimator());
+    const BacklashInverseParams inv = comp.inverse().params();
+    comp.observe(w, y, fresh);
+    if (!fresh) {
+      by_hand.restart();
+      refill = true;
+      ASSERT_EQ(estimator_state(comp.estimator()), before) << k;
+      ASSERT_EQ(bits(comp.inverse().params().right), bits(inv.right)) << k;
+      ASSERT_EQ(bits(comp.inverse().params().left), bits(inv.left)) << k;
+      continue;
+    }
+    if (!refill) by_hand.step(w >= 0.0 ? w + cfg.input_shift : w - cfg.input_shift, y1);
+    refill = false;
+    y1 = y;
+    ASSERT_EQ(estimator_state(comp.estimator()), estimator_state(by_hand)) << "step " << k;
+  }
+  EXPECT_NEAR(comp.inverse().params().right, 0.004, 1e-4);
+  EXPECT_NEAR(comp.inverse().params().left, 0.0065, 1e-4);
 }

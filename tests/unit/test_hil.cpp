@@ -8,7 +8,7 @@
 
 #include "lash/hil/bench_layout.hpp"
 #include "lash/hil/nodes.hpp"
-#include "lash/hil/simulate.hpp"
+#include "lash/hil/schedule.hpp"
 #include "recorded_dto.hpp"
 
 using namespace lash;
@@ -192,7 +192,7 @@ TEST(HilSimulate, EqualsHandWrittenDiscreteLoop) {
   const double T = 0.005;
   const std::size_t N = 1000;
   BenchLayout L;
-  const SimulationResult sim = simulate_bench(L, master_config(T), slave_config(T), N);
+  const SimulationResult sim = simulate_bench(L, master_config(T), slave_config(T), ideal_schedule(N));
   ASSERT_EQ(sim.master.size(), N + 1);
   EXPECT_EQ(sim.master[0].state, MasterState::startup);
 
@@ -258,7 +258,7 @@ TEST(HilSimulate, ScenarioEqualsHandWrittenLoopWithDriftAndBothSolenoids) {
   mc.law = law;
   SlaveConfig sc = slave_config(T);
   sc.rig = plant;
-  const SimulationResult sim = simulate_bench(L, mc, sc, N);
+  const SimulationResult sim = simulate_bench(L, mc, sc, ideal_schedule(N));
   ASSERT_EQ(sim.master.size(), N + 1);
 
   rigs::PilotValveRig rig(plant.params, T, plant.seed);
@@ -274,7 +274,7 @@ TEST(HilSimulate, ScenarioEqualsHandWrittenLoopWithDriftAndBothSolenoids) {
     const double r = ref.next();
     double i = comp.command(pid.step(r - y) + law.feedforward * r);
     i = std::clamp(i, law.command_min, law.command_max);
-    comp.observe(i, y);
+    comp.observe(i, y, true);
     negative = negative || i < -300.0;
     applied = i >= 0 ? L.quantize_current(i) : -L.quantize_current(-i);
     const MasterStepLog& m = sim.master[k + 1];

@@ -1,7 +1,9 @@
 // CSV/TOML I/O: round-trip number text, error locations, atomic output.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <random>
 #include <filesystem>
 #include <fstream>
 
@@ -245,4 +247,48 @@ TEST(Table, GapsAreFoundAndNotAveragedIntoDt) {
   EXPECT_EQ(analyse_sampling(u).dt, 0.4 / 3);
   EXPECT_TRUE(analyse_sampling(u).gap_rows.empty());
   EXPECT_NEAR(analyse_sampling(u).max_jitter, 1.0, 1e-12);  // the 0.2 step against the median 0.1
+}
+
+TEST(Table, MedianStepOfLongRecordsIsTheSortedMiddle) {
+  // Long records take the selection path of analyse_sampling (no full sort); the median, gaps and
+  // jitter must be those of the definition: the sorted steps' middle (mean of the two middles for an
+  // even count), gaps above 5 x it, max |step - median| / median computed step by step.
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> jit(-0.3, 0.3);
+  std::uniform_int_distribution<int> coin(0, 1);
+  const auto reference = [](const std::vector<double>& t, double& med, double& jitter, std::size_t& gaps) {
+    std::vector<double> d;
+    for (std::size_t i = 1; i < t.size(); ++i) d.push_back(t[i] - t[i - 1]);
+    std::vector<double> s = d;
+    std::sort(s.begin(), s.end());
+    med = s.size() % 2 ? s[s.size() / 2] : 0.5 * (s[s.size() / 2] + s[s.size() / 2 - 1]);
+    jitter = 0.0;
+    gaps = 0;
+    for (double x : d) {
+      if (x > 5.0 * med) ++gaps;
+      else jitter = std::max(jitter, std::abs(x - med) / med);
+    }
+  };
+  for (std::size_t n : {40000, 40001, 300000, 300001}) {
+    for (int kind = 0; kind < 5; ++kind) {
+      std::vector<double> t(n);
+      for (std::size_t k = 0; k < n; ++k) {
+        const double base = static_cast<double>(k) * 0.005;
+        switch (kind) {
+          case 0: t[k] = base; break;                                                  // a few step values
+          case 1: t[k] = base + 0.005 * jit(rng); break;                               // all steps differ
+          case 2: t[k] = k ? t[k - 1] + (coin(rng) ? 0.004 : 0.006) : 0.0; break;      // two values, median at the edge
+          case 3: t[k] = k ? t[k - 1] + 0.001 * static_cast<double>(1 + k % 7) : 0.0; break;  // seven values
+          default: t[k] = base + (k > n / 3 ? 1.0 : 0.0) + (k > n / 2 ? 2.0 : 0.0); break;   // two gaps
+        }
+      }
+      double med = 0.0, jitter = 0.0;
+      std::size_t gaps = 0;
+      reference(t, med, jitter, gaps);
+      const Sampling s = analyse_sampling(t);
+      EXPECT_EQ(s.median_dt, med) << "n " << n << " kind " << kind;
+      EXPECT_EQ(s.max_jitter, jitter) << "n " << n << " kind " << kind;
+      EXPECT_EQ(s.gap_rows.size(), gaps) << "n " << n << " kind " << kind;
+    }
+  }
 }

@@ -159,11 +159,14 @@ struct CompensationConfig {
 ///   - static in_use(const Inverse&) -> PerSide<double>, the parameters as reported;
 ///   - Adapter(const CompensationConfig<Adapter>&);
 ///   - step(double a, double b) noexcept -> PerSide<GateInput>, one sample of the estimator;
+///   - restart() noexcept, a gap in the samples (observe(…, fresh = false)): the estimator's
+///     restart() and the adapter's own sample history, estimates kept;
 ///   - refine(Side, AdaptationReason) noexcept, the adapter's own refusal (e.g. not_excited);
 ///   - reason(Side) noexcept -> const char*, why a side is (not) used;
 ///   - identified(Side) noexcept, the estimator's own verdict on a side;
 ///   - estimator() -> const Estimator&.
 /// command() and observe() are noexcept, O(1) and allocation-free.
+/// Stale samples (observe(…, fresh = false)) neither update the estimator nor move the inverse.
 template <class Inverse, class Adapter>
 class Compensator {
  public:
@@ -198,8 +201,22 @@ class Compensator {
   /// After the command was applied: one sample (a, b) of the estimator (the adapter's meaning:
   /// valve (v(k) as applied, y(k) measured before it); carts (drive, driven position)).
   /// Adaptive mode steps the estimator and moves the inverse's parameters through the gates.
-  void observe(double a, double b) noexcept {
+  ///
+  /// `fresh` = false: b is not a new measurement of this step (the sensor frame was late and
+  /// the caller held the previous value, or the law did not run on this step). Such a step is a
+  /// gap in the record: the estimator is not stepped (its estimates, covariances, update counts
+  /// and verdict stay bit-unchanged) but restarted (restart(): its delayed samples, instruments
+  /// and filters are cleared, and the next warmup() fresh samples refill them without an
+  /// update, so no regression pairs samples from both sides of the gap); the gates are not
+  /// stepped (the inverse keeps its parameters, the settle and hold timers count fresh samples
+  /// only). Every step fresh = exactly the sequence without this argument.
+  void observe(double a, double b, bool fresh) noexcept {
     if (cfg_.mode != CompensationMode::adaptive) return;
+    if (!fresh) {
+      adapter_.restart();
+      ++stale_;
+      return;
+    }
     const PerSide<GateInput> e = adapter_.step(a, b);
     const double old_r = gate_r_.value(), old_l = gate_l_.value();
     const double r = gate_r_.step(e.right.ok, e.right.value);
@@ -220,6 +237,8 @@ class Compensator {
   }
   /// Samples on which the inverse's parameters changed.
   std::uint64_t updates() const noexcept { return updates_; }
+  /// observe() calls with fresh = false (gaps: the estimator restarted, the inverse held).
+  std::uint64_t stale_samples() const noexcept { return stale_; }
   /// The worse of the two sides' reasons (adapting only when both adapt).
   AdaptationReason reason() const noexcept {
     if (cfg_.mode != CompensationMode::adaptive) return AdaptationReason::nominal;
@@ -241,7 +260,7 @@ class Compensator {
   Adapter adapter_;
   ParameterGate gate_r_, gate_l_;
   Dither dither_;
-  std::uint64_t updates_ = 0;
+  std::uint64_t updates_ = 0, stale_ = 0;
 };
 
 /// Input deadzone (pilot valve): InputDeadzoneEstimator on (v(k) as applied, y(k)) → the edges
@@ -264,6 +283,13 @@ class DeadzoneAdapter {
   }
   explicit DeadzoneAdapter(const CompensationConfig<DeadzoneAdapter>& c);
   PerSide<GateInput> step(double v_applied, double y) noexcept;
+  /// A gap: the estimator's restart(); the excitation record skips the samples the estimator
+  /// does not update on (its warm-up), as it skips those inside the guesses.
+  void restart() noexcept {
+    est_.restart();
+    v1_ = 0.0;
+    warm_ = est_.warmup();
+  }
   AdaptationReason refine(Side s, AdaptationReason r) const noexcept {
     return (not_excited_[s] && r == AdaptationReason::not_identified) ? AdaptationReason::not_excited : r;
   }
@@ -278,6 +304,7 @@ class DeadzoneAdapter {
   PerSide<double> need_;  // min_excitation_ratio × nominal per side
   detail::Excitation exc_r_, exc_l_;
   double v1_ = 0.0;
+  std::uint32_t warm_ = 0;  // samples of the estimator's warm-up still to go after a restart()
   PerSide<bool> not_excited_{};
 };
 
@@ -320,10 +347,19 @@ class BacklashAdapter {
   explicit BacklashAdapter(const CompensationConfig<BacklashAdapter>& c) : est_(c.estimator), s_(c.estimator.input_shift) {}
   /// w: driving position, y: driven position, both measured at k.
   PerSide<GateInput> step(double w, double y) noexcept {
+    if (gap_) {  // after restart(): y1_ is from before the gap; this sample only refills it
+      gap_ = false;
+      y1_ = y;
+      return gates();
+    }
     est_.step(w >= 0.0 ? w + s_ : w - s_, y1_);
     y1_ = y;
-    const SideParams r = est_.params(Side::right), l = est_.params(Side::left);
-    return {{r.identified, r.d + (r.c - s_)}, {l.identified, l.d - (l.c + s_)}};
+    return gates();
+  }
+  /// A gap: the estimator's restart(), and the driven position one sample late is dropped.
+  void restart() noexcept {
+    est_.restart();
+    gap_ = true;
   }
   AdaptationReason refine(Side, AdaptationReason r) const noexcept { return r; }
   const char* reason(Side s) const noexcept;
@@ -331,9 +367,14 @@ class BacklashAdapter {
   const Estimator& estimator() const noexcept { return est_; }
 
  private:
+  PerSide<GateInput> gates() const noexcept {
+    const SideParams r = est_.params(Side::right), l = est_.params(Side::left);
+    return {{r.identified, r.d + (r.c - s_)}, {l.identified, l.d - (l.c + s_)}};
+  }
   DeadzoneDeadbandEstimator est_;
   double s_;
   double y1_ = 0.0;
+  bool gap_ = false;
 };
 
 /// The valve's compensator (names kept: DeadzoneCompensationConfig, DeadzoneCompensator).

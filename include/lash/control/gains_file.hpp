@@ -25,6 +25,8 @@
 /// (→ deadzone_inverse.offset_mA), `current_min_mA`/`current_max_mA` (→ saturation.min_mA/max_mA).
 /// A setting given under two names is an error.
 /// Unknown keys are rejected; errors name file, line and key (InputError). Not real-time code.
+/// Reader and writer are generated from the field table (controller_fields.hpp), which also
+/// lists every key, its unit and range (docs/control.md shows it).
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -38,7 +40,7 @@ namespace lash {
 /// the warning goes to stderr.
 using ControllerWarn = std::function<void(const std::string&)>;
 
-/// Reads the controller tables of `table` (its other keys are left to the caller's finish()).
+/// Reads the controller tables of `table` (implemented in controller_fields.cpp) (its other keys are left to the caller's finish()).
 ControllerConfig read_controller_config(TomlTable& table, const ControllerWarn& warn = {});
 /// A gains file: the controller tables and nothing else.
 ControllerConfig load_controller_config(const std::filesystem::path& path, const ControllerWarn& warn = {});

@@ -304,6 +304,7 @@ class MasterNode {
   void send(can::Bus& bus, const can::Frame& f, double now_s) noexcept;
   void record(const can::Frame& f, bool sent) noexcept;
   void control(can::Bus& bus, double r, double now_s) noexcept;
+  void control_states(can::Bus& bus, double r, double now_s) noexcept;
   double law(double r, double y) noexcept;
   void reset_law() noexcept;
   BenchLayout layout_;
@@ -317,6 +318,7 @@ class MasterNode {
   InputWatch watch_;
   EventLog events_;
   bool fresh_ = false, bad_ = false;
+  bool law_ran_ = false;  ///< the scenario law ran in this control step (else: a gap for the compensator)
   std::uint32_t k_ = 0;
   std::int64_t m_ = -1;
   std::uint32_t last_cro_k_ = 0;

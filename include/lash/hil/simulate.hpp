@@ -1,11 +1,12 @@
 #pragma once
 /// @file simulate.hpp
-/// Closed-loop simulation of the bench with the nodes' own step functions
-/// (`lash hil simulate`): the master and the slave exchange their frames through
-/// an in-process link in the emulation's order — master sends CRO; slave answers
-/// with the recorded DTO; then each period slave.step() and master.step() — so the
-/// quantisation (current 0.1 mA, sensor uint16 code), the one-step bus delay and
-/// the step order are those of the emulation and the traces compare sample for sample.
+/// What a closed-loop simulation of the bench returns, and an in-process link between two
+/// nodes. The simulation itself (`lash hil simulate`, `lash closed-loop` on a valve scenario) is
+/// hil::simulate_bench(layout, master, slave, schedule) of schedule.hpp: with
+/// ideal_schedule(N) the master and the slave exchange their frames in the emulation's order —
+/// master sends CRO; slave answers with the recorded DTO; then each period slave.step() and
+/// master.step() — so the quantisation (current 0.1 mA, sensor uint16 code), the one-step bus
+/// delay and the step order are those of the emulation and the traces compare sample for sample.
 #include <cstddef>
 #include <deque>
 #include <memory>
@@ -33,11 +34,5 @@ struct SimulationResult {
   std::vector<MasterEvent> events;
   CompensationState compensation;     ///< the master's scenario compensator at the end (on = false without one)
 };
-
-/// Runs the master's CONNECT step and `control_steps` periods of slave.step(); master.step().
-/// Throws std::invalid_argument on invalid configurations or when the slave does not
-/// answer CONNECT (e.g. its recorded reply is not a positive DTO).
-SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& master, const SlaveConfig& slave,
-                                std::size_t control_steps);
 
 }  // namespace lash::hil

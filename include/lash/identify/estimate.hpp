@@ -11,7 +11,9 @@
 
 #include "lash/identify/any_estimator.hpp"
 #include "lash/identify/config_file.hpp"
+#include "lash/identify/config_sources.hpp"
 #include "lash/identify/estimate_report.hpp"
+#include "lash/io/table.hpp"
 
 namespace lash {
 
@@ -34,13 +36,47 @@ double sample_period(std::span<const double> t, const std::string& file = "", co
 EstimatorConfig config_for_record(EstimatorConfig cfg, const EstimationJob& job, double dt_s);
 
 /// Scores a finished run: the NRMSE window of `job` over t, y and the simulated output.
+/// t_increasing: t is known to increase strictly (sample_period checked it): the window's rows are
+/// then found by bisection and only y and ysim are read (same samples, same sum, same bits).
 EstimateResult score_estimate(const EstimateReport& report, double dt_s, const EstimationJob& job,
-                              std::span<const double> t, std::span<const double> y, std::span<const double> ysim);
+                              std::span<const double> t, std::span<const double> y, std::span<const double> ysim,
+                              bool t_increasing = false);
 
 /// The fit part of the report (estimate_json / estimate_text).
 ReportFit report_fit(const EstimateResult& result) noexcept;
 
 /// The JSON object printed by `lash estimate --json`: estimate_json(report, report_fit(result)).
 std::string to_json(const EstimateResult& result);
+
+struct ArrayEstimateOptions {
+  bool trace = false;          ///< keep every parameter per sample (run.run.params)
+  double outlier_gate = 12.0;  ///< estimate_auto's outlier gate [innovation scales] (0 = off)
+  bool intervals = true;       ///< the 95 % intervals (add_intervals: one more estimator pass over sections)
+  /// The sampling of t when the caller has it already (a file's reader analysed it): else analysed here.
+  const Sampling* sampling = nullptr;
+  std::size_t rows_skipped = 0;  ///< rows the reader dropped for a non-finite value (reported, not used)
+  int first_skipped_line = 0;    ///< file line of the first of them
+};
+
+/// One whole-record estimation from arrays: `lash estimate` (on a file's columns) and Python's
+/// lash.estimate make exactly this call.
+struct ArrayEstimate {
+  AutoRun run;            ///< settings of the final run, per-sample yhat/ysim, guesses, outliers
+  EstimateResult result;  ///< report, dt, NRMSE and its window
+  Sampling sampling;      ///< gaps and median step of t
+  Preset preset = Preset::lash;
+  EstimationJob job;      ///< the job part of the resolved settings (columns, NRMSE window)
+  ReportFit fit;          ///< the fit part of the report (NRMSE, window, skipped rows, gaps, median step)
+  double estimator_s = 0.0;  ///< wall time of estimate_auto alone [s] (`lash estimate --timing`)
+  std::string json;       ///< what `lash estimate --json` prints (estimate_auto_json)
+};
+
+/// Python's lash.estimate, the library calls in one place: settings checked (before the data),
+/// t checked (sample_period), its sampling analysed (analyse_sampling: dt = mean step without gaps,
+/// the estimator restarts at each gap), the settings resolved for the record (resolve_settings),
+/// estimate_auto, the intervals, the NRMSE of the free run (score_estimate) and the JSON report.
+/// t [s], v, y: equal lengths (else InputError naming v or y). Not real-time safe.
+ArrayEstimate estimate_arrays(const SettingsSources& src, std::span<const double> t, std::span<const double> v,
+                              std::span<const double> y, const ArrayEstimateOptions& options = {});
 
 }  // namespace lash
