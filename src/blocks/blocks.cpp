@@ -61,14 +61,14 @@ FirstOrder::FirstOrder(PerSide<FirstOrderParams> p) : p_(p) {
 
 MovingAverage::MovingAverage(std::size_t length) {
   require(length >= 1, "moving average length must be >= 1");
-  buf_.assign(length, 0.0);
-  len_ = static_cast<double>(length);
+  buf_.assign(2 * length, 0.0);
+  inv_len_ = 1.0 / static_cast<double>(length);
   n_ = length;
 }
 void MovingAverage::reset() noexcept {
   for (auto& v : buf_) v = 0.0;
   pos_ = 0;
-  sum_ = comp_ = 0.0;
+  head_ = 0.0;
 }
 
 BackwardDifference::BackwardDifference(double dt_s) {

@@ -343,7 +343,7 @@ std::uint64_t DeadzoneDeadbandEstimator::skipped() const noexcept {
   return n;
 }
 
-DeadzoneDeadbandEstimator::Derived DeadzoneDeadbandEstimator::derive(Side side) const noexcept {
+DeadzoneDeadbandEstimator::Derived DeadzoneDeadbandEstimator::derive(Side side, bool with_verdict) const noexcept {
   const std::uint64_t np = count_[key(side, true)], nm = count_[key(side, false)];
   double a1, b1, c, d;
   const bool updated = np >= cfg_.min_updates && nm >= cfg_.min_updates;
@@ -392,6 +392,7 @@ DeadzoneDeadbandEstimator::Derived DeadzoneDeadbandEstimator::derive(Side side) 
   // guesses lie outside the deadzone, c_l* < c < c_r*, and a deadband half-width is not
   // negative. An estimate outside that is a transient of a key that has not converged yet.
   q.usable = updated && solvable && finite && guess_ok && d >= 0.0;
+  if (!with_verdict) return q;  // the free run's refresh reads only the values and `usable`
   verdict_rules::Evidence ev;
   ev.side = side;
   ev.updated = updated;
@@ -408,7 +409,7 @@ DeadzoneDeadbandEstimator::Derived DeadzoneDeadbandEstimator::derive(Side side) 
 }
 
 void DeadzoneDeadbandEstimator::refresh(Side side) noexcept {
-  const Derived q = derive(side);
+  const Derived q = derive(side, false);
   // settled: (c, d) stopped moving between refreshes (see EstimatorConfig::settle_tol)
   const bool still = std::fabs(q.p.c - prev_c_[side]) + std::fabs(q.p.d - prev_d_[side]) <=
                      cfg_.settle_tol * (std::fabs(q.p.c) + std::fabs(q.p.d));
@@ -448,8 +449,11 @@ double DeadzoneDeadbandEstimator::predict_free(Side side, double y1, double v1) 
   // − model lands below it, otherwise the output holds.
   double up, down;
   if (cfg_.pooled) {
-    up = pooled_[side].predict({-y1, v1, 1.0, -1.0});
-    down = pooled_[side].predict({-y1, v1, 1.0, 1.0});
+    // φᵀη with φ = [−y1, v1, 1, ∓1]: the shared part once, then ∓g (the same sums as predict())
+    const auto& e = pooled_[side].eta();
+    const double base = (0.0 + -y1 * e[0] + v1 * e[1]) + e[2];
+    up = base - e[3];
+    down = base + e[3];
   } else {
     up = rls_[key(side, true)].predict({-y1, v1, 1.0});
     down = rls_[key(side, false)].predict({-y1, v1, 1.0});

@@ -13,6 +13,7 @@
 #include "lash/blocks.hpp"
 #include "lash/identify/any_estimator.hpp"
 #include "lash/identify/auto.hpp"
+#include "lash/identify/preprocess.hpp"
 #include "lash/identify/rls.hpp"
 #include "lash/plant/plant.hpp"
 #include "lash/plant/plant_file.hpp"
@@ -60,6 +61,66 @@ TEST(Rls, FirstStepMatchesHandComputation) {
   EXPECT_NEAR(r.P()[0][0], (10.0 - 100.0 / 50.5) / 0.5, 1e-12);
   EXPECT_NEAR(r.P()[0][1], (0.0 - 200.0 / 50.5) / 0.5, 1e-12);
   EXPECT_NEAR(r.P()[1][1], (10.0 - 400.0 / 50.5) / 0.5, 1e-12);
+}
+
+/// Recursive IV with λ = 1 solves the normal equations of IV exactly (Söderström & Stoica 1989,
+/// §8): with R = P0⁻¹ + Σ z φᵀ and b = P0⁻¹ η0 + Σ z y, P = R⁻¹ and η = R⁻¹ b. Checked without an
+/// inverse: R·P = I and R·η = b, with R and b summed in long double from the same samples.
+/// With λ = 0.999: P = (λᵏ P0⁻¹ + Σ λ^(k−i) z φᵀ)⁻¹ likewise.
+template <std::size_t N>
+void iv_solves_normal_equations(double lambda) {
+  RlsConfig<N> c;
+  c.lambda = lambda;
+  c.p0 = 100.0;
+  for (std::size_t i = 0; i < N; ++i) c.eta0[i] = 0.5;
+  Rls<N> r(c);
+  Rng rng(3);
+  long double R[N][N] = {}, b[N] = {};
+  for (std::size_t i = 0; i < N; ++i) {
+    R[i][i] = 1.0L / c.p0;
+    b[i] = 0.5L / c.p0;
+  }
+  double y1 = 0.0, y2 = 0.0, y3 = 0.0;
+  for (int k = 0; k < 3000; ++k) {
+    const double v = std::sin(0.01 * k) * 50.0 + rng.gaussian();
+    const double y = 0.9 * y1 + 0.2 * v + 0.3 + rng.gaussian();
+    typename Rls<N>::Vec phi{}, z{};
+    const double f[4] = {-y1, v, 1.0, k % 2 ? 1.0 : -1.0}, g[4] = {-y3, v, 1.0, k % 2 ? 1.0 : -1.0};
+    for (std::size_t i = 0; i < N; ++i) {
+      phi[i] = f[i];
+      z[i] = g[i];
+    }
+    r.update_iv(phi, z, y);
+    for (std::size_t i = 0; i < N; ++i) {
+      b[i] = lambda * b[i] + static_cast<long double>(z[i]) * y;
+      for (std::size_t j = 0; j < N; ++j) R[i][j] = lambda * R[i][j] + static_cast<long double>(z[i]) * phi[j];
+    }
+    y3 = y2;
+    y2 = y1;
+    y1 = y;
+  }
+  double worst_p = 0.0, worst_eta = 0.0;
+  for (std::size_t i = 0; i < N; ++i) {
+    long double re = 0.0L, bn = 0.0L;
+    for (std::size_t j = 0; j < N; ++j) {
+      long double rp = 0.0L;
+      for (std::size_t m = 0; m < N; ++m) rp += R[i][m] * r.P()[m][j];
+      worst_p = std::max(worst_p, static_cast<double>(std::fabs(rp - (i == j ? 1.0L : 0.0L))));
+      re += R[i][j] * r.eta(j);
+    }
+    bn = std::fabs(b[i]) + 1.0L;
+    worst_eta = std::max(worst_eta, static_cast<double>(std::fabs(re - b[i]) / bn));
+  }
+  EXPECT_LT(worst_p, 1e-9) << "N = " << N;
+  EXPECT_LT(worst_eta, 1e-9) << "N = " << N;
+  EXPECT_EQ(r.updates(), 3000u);
+}
+
+TEST(Rls, IvSolvesTheNormalEquations) {
+  iv_solves_normal_equations<3>(1.0);
+  iv_solves_normal_equations<4>(1.0);  // the pooled deadzone-deadband regression (its own code path)
+  iv_solves_normal_equations<3>(0.999);
+  iv_solves_normal_equations<4>(0.999);
 }
 
 TEST(Rls, NonFiniteSampleIsSkippedAndCounted) {
@@ -212,6 +273,41 @@ SimulationTrace eq34_sine(double duration_s, double noise_variance = 0.0, std::u
   spec.noise_variance = noise_variance;
   spec.seed = seed;
   return simulate(plant, spec);
+}
+
+TEST(Preprocessor, MatchesDirectWindowMeansAndDerivative) {
+  // lash's deadzone-deadband filters (MA40 on v and y, MA20 on the backward difference of
+  // y_f, both regression signals delayed 10): every output against sums over the stored raw
+  // samples (history 0 before the first), on 2·10^5 samples of a noisy sine.
+  NoiseSettings ns;
+  ns.filter_length = 40;
+  ns.filter_input = true;
+  ns.derivative_filter_length = 20;
+  ns.align_delay = 10;
+  const double dt = 0.005;
+  Preprocessor pre(ns, dt);
+  Rng rng(5);
+  std::vector<double> v, y;
+  auto at = [](const std::vector<double>& x, long k) { return k < 0 ? 0.0 : x[static_cast<std::size_t>(k)]; };
+  auto mean = [&](const std::vector<double>& x, long k, long m) {
+    long double s = 0.0L;
+    for (long j = 0; j < m; ++j) s += at(x, k - j);
+    return static_cast<double>(s / m);
+  };
+  double worst = 0.0;
+  for (long k = 0; k < 200'000; ++k) {
+    v.push_back(600.0 * std::sin(0.005 * static_cast<double>(k)) + 10.0 * rng.gaussian());
+    y.push_back(300.0 * std::sin(0.005 * static_cast<double>(k) - 0.3) + 14.0 * rng.gaussian());
+    const Conditioned c = pre.step(v.back(), y.back());
+    if (k % 997 != 0 && k > 100) continue;
+    const double vf = mean(v, k - 10, 40), yf = mean(y, k - 10, 40);
+    long double ds = 0.0L;
+    for (long j = 0; j < 20; ++j) ds += (mean(y, k - j, 40) - mean(y, k - j - 1, 40)) / dt;
+    const double ydot = static_cast<double>(ds / 20);
+    worst = std::max({worst, std::fabs(c.v - vf) / 600.0, std::fabs(c.y - yf) / 300.0, std::fabs(c.ydot - ydot) / 300.0});
+  }
+  EXPECT_LT(worst, 1e-12);
+  EXPECT_EQ(pre.memory_samples(), 61u);  // the derivative path: 40 (MA) + 1 (difference) + 20 (MA of ẏ)
 }
 
 TEST(Estimators, E1NoiseFreeThesisEq34) {

@@ -3,7 +3,6 @@
 /// M-point non-weighted moving average that includes the current sample
 /// (thesis §1.4.5): delay (M−1)/2 samples, variance of white noise / M.
 /// Storage is allocated once at construction; step() is O(1).
-#include <cmath>
 #include <cstddef>
 #include <vector>
 
@@ -15,33 +14,40 @@ class MovingAverage {
   explicit MovingAverage(std::size_t length);
 
   /// Mean of the last M inputs (missing history counts as 0, like every state at k = 0).
-  /// Kept as an exact running sum with Neumaier compensation, so no drift over long runs.
+  /// The window sum is never a running sum (no value is ever subtracted), so it cannot drift:
+  /// the window is the head of the current block of M samples (summed as they come) plus the
+  /// tail of the previous block, whose suffix sums are recomputed from the stored values once
+  /// per block (M additions every M samples). The output is a function of the window's values
+  /// alone, with a rounding error below M·ε·Σ|x| however long the run.
   double step(double x) noexcept {
-    const double old = buf_[pos_];
     buf_[pos_] = x;
-    if (++pos_ == n_) pos_ = 0;
-    add(x);
-    add(-old);
-    return (sum_ + comp_) / len_;
+    head_ += x;
+    const double out = (head_ + buf_[n_ + pos_]) * inv_len_;  // buf_[n_ + p]: Σ old[p+1 .. M−1]
+    if (++pos_ == n_) next_block();
+    return out;
   }
   void reset() noexcept;
-  std::size_t length() const noexcept { return buf_.size(); }
+  std::size_t length() const noexcept { return n_; }
   /// Group delay (M−1)/2 [samples].
-  double delay_samples() const noexcept { return 0.5 * static_cast<double>(buf_.size() - 1); }
+  double delay_samples() const noexcept { return 0.5 * static_cast<double>(n_ - 1); }
 
  private:
-  void add(double v) noexcept {
-    const double t = sum_ + v;
-    if (std::fabs(sum_) >= std::fabs(v)) comp_ += (sum_ - t) + v;  // fabs: no branch, the same comparison
-    else comp_ += (v - t) + sum_;
-    sum_ = t;
+  /// A block of M samples is complete: its suffix sums become the tail of the next window.
+  void next_block() noexcept {
+    double t = 0.0;
+    buf_[2 * n_ - 1] = 0.0;
+    for (std::size_t i = n_ - 1; i > 0; --i) {
+      t += buf_[i];
+      buf_[n_ + i - 1] = t;
+    }
+    head_ = 0.0;
+    pos_ = 0;
   }
-  std::vector<double> buf_;
-  double len_ = 1.0;  // M as a double (the same quotient as dividing by the converted size)
-  std::size_t n_ = 1;  // M
+  std::vector<double> buf_;  // [0, M): the current block's values; [M, 2M): the previous block's suffix sums
+  double inv_len_ = 1.0;     // 1/M
+  std::size_t n_ = 1;        // M
   std::size_t pos_ = 0;
-  double sum_ = 0.0;
-  double comp_ = 0.0;
+  double head_ = 0.0;        // Σ of the current block's values so far
 };
 
 }  // namespace lash

@@ -236,7 +236,8 @@ class DeadzoneDeadbandEstimator {
     SideParams p;
     bool usable = false;
   };
-  Derived derive(Side s) const noexcept;
+  /// with_verdict = false: the values and `usable` only (p.reason left at its default).
+  Derived derive(Side s, bool with_verdict = true) const noexcept;
   void refresh(Side s) noexcept;
   double predict_free(Side s, double y1, double v1) const noexcept;
   void simulate(double v) noexcept;

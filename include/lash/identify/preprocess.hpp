@@ -7,9 +7,9 @@
 ///   regression signals = Delay_align(v_f), Delay_align(y_f) so they line up with ẏ.
 /// Storage is allocated at construction; step() is noexcept, O(1), allocation-free.
 #include <cstddef>
+#include <cstdint>
+#include <vector>
 
-#include "lash/blocks/delay.hpp"
-#include "lash/blocks/difference.hpp"
 #include "lash/blocks/moving_average.hpp"
 #include "lash/identify/config.hpp"
 
@@ -34,11 +34,17 @@ class Preprocessor {
       return {v, y, d};
     }
     const double yf = filter_y_ ? ma_y_.step(y) : y;
-    double vf = filter_v_ ? ma_v_.step(v) : v;
-    vf = delay_v_.step(vf);
-    double d = diff_.step(separate_pre_ ? (filter_p_ ? ma_p_.step(y) : y) : yf);
-    if (filter_d_) d = ma_d_.step(d);
-    return {align_v_.step(vf), align_y_.step(yf), d};
+    const double vf = filter_v_ ? ma_v_.step(v) : v;
+    const double x = separate_pre_ ? (filter_p_ ? ma_p_.step(y) : y) : yf;  // the derivative's input
+    const std::size_t k = k_++ & mask_;
+    double* const h = hist_.data();
+    h[k] = vf;
+    h[cap_ + k] = yf;
+    if (separate_pre_) h[2 * cap_ + k] = x;  // otherwise x = y_f, read from y_f's ring
+    // MA_M2 of the backward difference telescopes: (1/M2)·Σ_{j<M2} (x(k−j) − x(k−j−1))/T
+    // = (x(k) − x(k−M2))/(M2·T), with x = 0 before the first sample as in every filter.
+    const double d = (x - h[x_ring_ + ((k - lag_d_) & mask_)]) * inv_ddt_;
+    return {h[(k - lag_v_) & mask_], h[cap_ + ((k - lag_y_) & mask_)], d};
   }
 
   void reset() noexcept;
@@ -50,13 +56,18 @@ class Preprocessor {
 
  private:
   bool identity_;
-  bool filter_y_, filter_v_, filter_d_, separate_pre_, filter_p_;
+  bool filter_y_, filter_v_, separate_pre_, filter_p_;
   double inv_dt_;
+  double inv_ddt_;  // 1/(M2·T): the derivative's moving average folded into the difference
   double y_prev_ = 0.0;
   NoiseSettings s_;
-  MovingAverage ma_y_, ma_v_, ma_d_, ma_p_;
-  BackwardDifference diff_;
-  Delay delay_v_, align_v_, align_y_;
+  MovingAverage ma_y_, ma_v_, ma_p_;
+  // One history ring per signal (v_f, y_f, derivative input), cap_ (a power of two) slots each:
+  // the input and alignment delays and the derivative read from it.
+  std::size_t cap_ = 1, mask_ = 0, x_ring_ = 0;
+  std::size_t lag_v_ = 0, lag_y_ = 0, lag_d_ = 1;
+  std::uint64_t k_ = 0;
+  std::vector<double> hist_;
 };
 
 /// Direction of motion from ẏ with a dead band (thesis §1.4.5): +1, −1 or 0.
