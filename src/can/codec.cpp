@@ -77,22 +77,25 @@ void SignalCodec::write_window(const SignalCodec& c, std::uint8_t* d, std::size_
   }
 }
 
+namespace {
+/// Byte and bit (0 = LSB) in the payload of bit i (0 = the raw value's LSB) of a field of `len`
+/// bits starting at DBC start bit `start` (the MSB's position for Motorola, the LSB's for Intel).
+template <bool Motorola>
+constexpr std::pair<std::uint32_t, std::uint32_t> field_bit(std::uint32_t start, std::uint32_t len,
+                                                            std::uint32_t i) noexcept {
+  if (Motorola) {
+    const std::uint32_t p = 8 * (start / 8) + 7 - start % 8 + (len - 1 - i);
+    return {p / 8, 7 - p % 8};
+  }
+  return {(start + i) / 8, (start + i) % 8};
+}
+}  // namespace
+
 template <bool Motorola>
 std::uint64_t SignalCodec::read_bits(const SignalCodec& c, const std::uint8_t* d, std::size_t) noexcept {
   std::uint64_t raw = 0;
-  const std::uint32_t len = c.length_;
-  const std::uint32_t start = c.signal_.start_bit;
-  const std::uint32_t q = 8 * (start / 8) + 7 - start % 8;
-  for (std::uint32_t i = 0; i < len; ++i) {
-    std::uint32_t byte, bit;
-    if (Motorola) {
-      const std::uint32_t p = q + (len - 1 - i);
-      byte = p / 8;
-      bit = 7 - p % 8;
-    } else {
-      byte = (start + i) / 8;
-      bit = (start + i) % 8;
-    }
+  for (std::uint32_t i = 0; i < c.length_; ++i) {
+    const auto [byte, bit] = field_bit<Motorola>(c.signal_.start_bit, c.length_, i);
     raw |= static_cast<std::uint64_t>((d[byte] >> bit) & 1u) << i;
   }
   return raw;
@@ -100,19 +103,8 @@ std::uint64_t SignalCodec::read_bits(const SignalCodec& c, const std::uint8_t* d
 
 template <bool Motorola>
 void SignalCodec::write_bits(const SignalCodec& c, std::uint8_t* d, std::size_t, std::uint64_t raw) noexcept {
-  const std::uint32_t len = c.length_;
-  const std::uint32_t start = c.signal_.start_bit;
-  const std::uint32_t q = 8 * (start / 8) + 7 - start % 8;
-  for (std::uint32_t i = 0; i < len; ++i) {
-    std::uint32_t byte, bit;
-    if (Motorola) {
-      const std::uint32_t p = q + (len - 1 - i);
-      byte = p / 8;
-      bit = 7 - p % 8;
-    } else {
-      byte = (start + i) / 8;
-      bit = (start + i) % 8;
-    }
+  for (std::uint32_t i = 0; i < c.length_; ++i) {
+    const auto [byte, bit] = field_bit<Motorola>(c.signal_.start_bit, c.length_, i);
     const auto m = static_cast<std::uint8_t>(1u << bit);
     if ((raw >> i) & 1u) {
       d[byte] = static_cast<std::uint8_t>(d[byte] | m);
