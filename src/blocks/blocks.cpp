@@ -71,6 +71,18 @@ void MovingAverage::reset() noexcept {
   head_ = 0.0;
 }
 
+MovingAveragePair::MovingAveragePair(std::size_t length) {
+  require(length >= 1, "moving average length must be >= 1");
+  buf_.assign(2 * length, v2{0.0, 0.0});
+  inv_len_ = 1.0 / static_cast<double>(length);
+  n_ = length;
+}
+void MovingAveragePair::reset() noexcept {
+  for (auto& v : buf_) v = v2{0.0, 0.0};
+  pos_ = 0;
+  head_ = v2{0.0, 0.0};
+}
+
 BackwardDifference::BackwardDifference(double dt_s) {
   require(finite(dt_s) && dt_s > 0, "dt must be > 0");
   dt_ = dt_s;

@@ -273,6 +273,38 @@ void DeadzoneDeadbandEstimator::restart() noexcept {
   warm_ = warmup_;
 }
 
+// simulate() and predict_free() run on every sample: defined here, before step(), and inlined
+// into it (a call each cost about a tenth of the sample).
+[[gnu::always_inline]] inline double DeadzoneDeadbandEstimator::predict_free(Side side, double y1, double v1) const noexcept {
+  // Deadband logic in the y domain: moving up if the + model lands above y(k−1), down if the
+  // − model lands below it, otherwise the output holds.
+  double up, down;
+  if (cfg_.pooled) {
+    // φᵀη with φ = [−y1, v1, 1, ∓1]: the shared part once, then ∓g (the same sums as predict())
+    const auto& e = pooled_[side].eta();
+    const double base = (0.0 + -y1 * e[0] + v1 * e[1]) + e[2];
+    up = base - e[3];
+    down = base + e[3];
+  } else {
+    up = rls_[key(side, true)].predict({-y1, v1, 1.0});
+    down = rls_[key(side, false)].predict({-y1, v1, 1.0});
+  }
+  if (up > y1) return up;
+  if (down < y1) return down;
+  return y1;
+}
+
+[[gnu::always_inline]] inline void DeadzoneDeadbandEstimator::simulate(double v) noexcept {
+  const Side s = detail::free_run_side(vraw1_, sc_, sim_last_, cfg_.sim_side_by_sign);
+  sim_last_ = s;
+  const double u = detail::deadzone(vraw1_, sc_.left, sc_.right);
+  w_ = -sa1_[s] * w_ + sb1_[s] * u;
+  const double d = sd_[s];
+  if (w_ < ysim_ - d) ysim_ = w_ + d;
+  else if (w_ > ysim_ + d) ysim_ = w_ - d;
+  vraw1_ = v;
+}
+
 double DeadzoneDeadbandEstimator::step(double v, double y) noexcept {
   if (!finite_all(v, y)) {
     ++skipped_;
@@ -323,17 +355,6 @@ double DeadzoneDeadbandEstimator::step(double v, double y) noexcept {
   simulate(v);
   fit_.add(y, ysim_);
   return yhat_;
-}
-
-void DeadzoneDeadbandEstimator::simulate(double v) noexcept {
-  const Side s = detail::free_run_side(vraw1_, sc_, sim_last_, cfg_.sim_side_by_sign);
-  sim_last_ = s;
-  const double u = detail::deadzone(vraw1_, sc_.left, sc_.right);
-  w_ = -sa1_[s] * w_ + sb1_[s] * u;
-  const double d = sd_[s];
-  if (w_ < ysim_ - d) ysim_ = w_ + d;
-  else if (w_ > ysim_ + d) ysim_ = w_ - d;
-  vraw1_ = v;
 }
 
 std::uint64_t DeadzoneDeadbandEstimator::skipped() const noexcept {
@@ -442,25 +463,6 @@ Reason DeadzoneDeadbandEstimator::verdict(Side s) const noexcept {
   const bool cond = cfg_.pooled ? conditioned(cfg_, pooled_[s])
                                 : conditioned(cfg_, rls_[key(s, true)]) && conditioned(cfg_, rls_[key(s, false)]);
   return verdict_rules::finish(params(s).reason, cond, fit_.nrmse(), cfg_.fit_threshold);
-}
-
-double DeadzoneDeadbandEstimator::predict_free(Side side, double y1, double v1) const noexcept {
-  // Deadband logic in the y domain: moving up if the + model lands above y(k−1), down if the
-  // − model lands below it, otherwise the output holds.
-  double up, down;
-  if (cfg_.pooled) {
-    // φᵀη with φ = [−y1, v1, 1, ∓1]: the shared part once, then ∓g (the same sums as predict())
-    const auto& e = pooled_[side].eta();
-    const double base = (0.0 + -y1 * e[0] + v1 * e[1]) + e[2];
-    up = base - e[3];
-    down = base + e[3];
-  } else {
-    up = rls_[key(side, true)].predict({-y1, v1, 1.0});
-    down = rls_[key(side, false)].predict({-y1, v1, 1.0});
-  }
-  if (up > y1) return up;
-  if (down < y1) return down;
-  return y1;
 }
 
 // ---------------------------------------------------------------- coupled carts (§1.6.3)

@@ -17,8 +17,8 @@ Preprocessor::Preprocessor(const NoiseSettings& s, double dt_s)
       inv_ddt_(1.0 / (static_cast<double>(s.derivative_filter_length) * dt_s)),
       s_(s),
       ma_y_(s.filter_length),
-      ma_v_(s.filter_length),
       ma_p_(s.derivative_prefilter_length == 0 ? 1 : s.derivative_prefilter_length),
+      ma_vy_(s.filter_input && s.filter_length > 1 ? s.filter_length : 1),
       lag_v_(s.input_delay + s.align_delay),
       lag_y_(s.align_delay),
       lag_d_(s.derivative_filter_length) {
@@ -33,7 +33,7 @@ Preprocessor::Preprocessor(const NoiseSettings& s, double dt_s)
 void Preprocessor::reset() noexcept {
   y_prev_ = 0.0;
   ma_y_.reset();
-  ma_v_.reset();
+  ma_vy_.reset();
   ma_p_.reset();
   k_ = 0;
   for (auto& h : hist_) h = 0.0;

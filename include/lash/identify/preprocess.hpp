@@ -33,8 +33,9 @@ class Preprocessor {
       y_prev_ = y;
       return {v, y, d};
     }
-    const double yf = filter_y_ ? ma_y_.step(y) : y;
-    const double vf = filter_v_ ? ma_v_.step(v) : v;
+    double yf = y, vf = v;
+    if (filter_v_) ma_vy_.step(v, y, vf, yf);  // filter_v_ implies filter_y_ (the same length M)
+    else if (filter_y_) yf = ma_y_.step(y);
     const double x = separate_pre_ ? (filter_p_ ? ma_p_.step(y) : y) : yf;  // the derivative's input
     const std::size_t k = k_++ & mask_;
     double* const h = hist_.data();
@@ -61,7 +62,8 @@ class Preprocessor {
   double inv_ddt_;  // 1/(M2·T): the derivative's moving average folded into the difference
   double y_prev_ = 0.0;
   NoiseSettings s_;
-  MovingAverage ma_y_, ma_v_, ma_p_;
+  MovingAverage ma_y_, ma_p_;
+  MovingAveragePair ma_vy_;  // v and y together when both are filtered
   // One history ring per signal (v_f, y_f, derivative input), cap_ (a power of two) slots each:
   // the input and alignment delays and the derivative read from it.
   std::size_t cap_ = 1, mask_ = 0, x_ring_ = 0;
