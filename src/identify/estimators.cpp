@@ -342,8 +342,8 @@ double DeadzoneDeadbandEstimator::step(double v, double y) noexcept {
     vrange_[sd].add(v1);
     yrange_[sd].add(y1);
     // Derived (a1, b1, c, d) are refreshed on every update until the side is usable, then
-    // every 4th update (the free run lags at most 3 samples; params() is always current).
-    if (!usable_[sd] || (++since_[sd] & 3u) == 0) refresh(sd);
+    // every 8th update (the free run lags at most 7 updates; params() is always current).
+    if (!usable_[sd] || (++since_[sd] & 7u) == 0) refresh(sd);
     last_ = sd;
   } else {
     yhat_ = predict_free(side ? *side : last_, y1, v1);
