@@ -39,36 +39,41 @@ inline void store64(std::uint8_t* p, std::uint64_t w, bool big_endian) noexcept 
 
 }  // namespace
 
-template <bool Motorola>
-std::uint64_t SignalCodec::read_window(const SignalCodec& c, const std::uint8_t* d, std::size_t n) noexcept {
+namespace {
+/// The 64-bit window of an n-byte payload that holds a field whose lowest byte is `first_byte`
+/// (little-endian for Intel, big-endian for Motorola; short payloads zero-padded): the word, the
+/// window's first byte `w`, and `lo`, the field's LSB position in the word (from `lo_base`, its
+/// position in a window starting at byte 0).
+struct Window {
   std::uint64_t word = 0;
   std::uint32_t w = 0;
+  std::int32_t lo = 0;
+};
+template <bool Motorola>
+Window load_window(const std::uint8_t* d, std::size_t n, std::uint32_t first_byte, std::int32_t lo_base) noexcept {
+  Window win;
   if (n >= 8) {
-    w = std::min<std::uint32_t>(c.first_byte_, static_cast<std::uint32_t>(n - 8));
-    word = load64(d + w, Motorola);
+    win.w = std::min<std::uint32_t>(first_byte, static_cast<std::uint32_t>(n - 8));
+    win.word = load64(d + win.w, Motorola);
   } else {
     for (std::size_t i = 0; i < n; ++i)
-      word |= static_cast<std::uint64_t>(d[i]) << (Motorola ? 56 - 8 * i : 8 * i);
+      win.word |= static_cast<std::uint64_t>(d[i]) << (Motorola ? 56 - 8 * i : 8 * i);
   }
-  const std::int32_t lo = Motorola ? c.lo_base_ + 8 * static_cast<std::int32_t>(w)
-                                   : c.lo_base_ - 8 * static_cast<std::int32_t>(w);
-  return (word >> lo) & c.mask_;
+  win.lo = Motorola ? lo_base + 8 * static_cast<std::int32_t>(win.w) : lo_base - 8 * static_cast<std::int32_t>(win.w);
+  return win;
+}
+}  // namespace
+
+template <bool Motorola>
+std::uint64_t SignalCodec::read_window(const SignalCodec& c, const std::uint8_t* d, std::size_t n) noexcept {
+  const Window win = load_window<Motorola>(d, n, c.first_byte_, c.lo_base_);
+  return (win.word >> win.lo) & c.mask_;
 }
 
 template <bool Motorola>
 void SignalCodec::write_window(const SignalCodec& c, std::uint8_t* d, std::size_t n, std::uint64_t raw) noexcept {
-  std::uint64_t word = 0;
-  std::uint32_t w = 0;
-  if (n >= 8) {
-    w = std::min<std::uint32_t>(c.first_byte_, static_cast<std::uint32_t>(n - 8));
-    word = load64(d + w, Motorola);
-  } else {
-    for (std::size_t i = 0; i < n; ++i)
-      word |= static_cast<std::uint64_t>(d[i]) << (Motorola ? 56 - 8 * i : 8 * i);
-  }
-  const std::int32_t lo = Motorola ? c.lo_base_ + 8 * static_cast<std::int32_t>(w)
-                                   : c.lo_base_ - 8 * static_cast<std::int32_t>(w);
-  word = (word & ~(c.mask_ << lo)) | (raw << lo);
+  const auto [old, w, lo] = load_window<Motorola>(d, n, c.first_byte_, c.lo_base_);
+  const std::uint64_t word = (old & ~(c.mask_ << lo)) | (raw << lo);
   if (n >= 8) {
     store64(d + w, word, Motorola);
   } else {

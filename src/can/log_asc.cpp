@@ -41,16 +41,6 @@ bool to_seconds(std::string_view s, double& t) {
   return r.ec == std::errc() && r.ptr == s.data() + s.size();
 }
 
-std::uint8_t dlc_to_len(std::uint32_t dlc) {
-  static constexpr std::uint8_t k[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 12, 16, 20, 24, 32, 48, 64};
-  return dlc < 16 ? k[dlc] : 0xFF;
-}
-
-std::uint32_t len_to_dlc(std::uint32_t len) {
-  for (std::uint32_t d = 0; d < 16; ++d)
-    if (dlc_to_len(d) >= len) return d;
-  return 15;
-}
 
 /// Parses the frame part of a line; "" on success, else why not.
 std::string parse_frame_line(const std::string_view* p, std::size_t n, int base, LogEntry& e) {
@@ -101,7 +91,7 @@ std::string parse_frame_line(const std::string_view* p, std::size_t n, int base,
       f.len = static_cast<std::uint8_t>(dlc);
       return "";
     }
-    if (dlc_to_len(len_to_dlc(len)) != len) return fmt::format("{} is no CAN FD data length", len);
+    if (fd_len(fd_dlc(len)) != len) return fmt::format("{} is no CAN FD data length", len);
     f.len = static_cast<std::uint8_t>(len);
     return bytes(k + 4, len);
   }
@@ -195,7 +185,7 @@ void write_asc(std::ostream& os, const std::vector<LogEntry>& entries) {
     if (f.fd) {
       const unsigned flags = (1u << 12) | (f.brs ? 1u << 13 : 0u) | (f.esi ? 1u << 14 : 0u);
       os << fmt::format("{: 9.6f} CANFD {:>3} {:<4} {:>8}  {:>32} {} {} {:x} {:>2} {} {:>8} {:>4} {:>8X} {:>8} {:>8} {:>8} {:>8} {:>8}\n",
-                        t, ch, "Rx", id, "", f.brs ? 1 : 0, f.esi ? 1 : 0, len_to_dlc(f.len), f.len, data, 0, 0, flags, 0, 0, 0, 0, 0);
+                        t, ch, "Rx", id, "", f.brs ? 1 : 0, f.esi ? 1 : 0, fd_dlc(f.len), f.len, data, 0, 0, flags, 0, 0, 0, 0, 0);
     } else if (f.remote) {
       os << fmt::format("{: 9.6f} {}  {:<15} {:<4} r {:x} \n", t, ch, id, "Rx", f.len);
     } else {

@@ -71,15 +71,6 @@ void put_systemtime(std::string& d, double t) {
 
 double start_of(double t) { return t >= 631152000.0 ? static_cast<double>(static_cast<std::int64_t>(t * 1000.0)) / 1000.0 : 0.0; }
 
-std::uint8_t fd_len(unsigned dlc) {
-  static constexpr std::uint8_t k[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 12, 16, 20, 24, 32, 48, 64};
-  return k[dlc & 15];
-}
-std::uint8_t fd_dlc(unsigned len) {
-  for (std::uint8_t d = 0; d < 16; ++d)
-    if (fd_len(d) >= len) return d;
-  return 15;
-}
 
 /// The common part of CAN_FD_MESSAGE and CAN_FD_MESSAGE_64: flags, then `valid` data bytes
 /// from `data` (the rest of the object); a remote frame's length is `remote_len`.
@@ -194,7 +185,7 @@ void parse_objects(std::string_view d, double start, const std::string& file, Lo
       id = get<std::uint32_t>(d, p + 4);
       const auto fdf = get<std::uint8_t>(d, p + 13);
       const bool fd = (fdf & 1) != 0;
-      if (!fd_payload(f, (flags & 0x80) != 0, fd, (fdf & 2) != 0, (fdf & 4) != 0, fd ? fd_len(dlc) : dlc,
+      if (!fd_payload(f, (flags & 0x80) != 0, fd, (fdf & 2) != 0, (fdf & 4) != 0, fd ? fd_len(dlc & 15u) : dlc,
                       get<std::uint8_t>(d, p + 14), d.substr(p + 20, next - (p + 20)), report, file, pos)) {
         pos = next;
         continue;
@@ -208,7 +199,7 @@ void parse_objects(std::string_view d, double start, const std::string& file, Lo
       const auto dlc = get<std::uint8_t>(d, p + 1);
       id = get<std::uint32_t>(d, p + 4);
       const auto fdf = get<std::uint32_t>(d, p + 12);
-      if (!fd_payload(f, (fdf & 0x10) != 0, (fdf & 0x1000) != 0, (fdf & 0x2000) != 0, (fdf & 0x4000) != 0, fd_len(dlc),
+      if (!fd_payload(f, (fdf & 0x10) != 0, (fdf & 0x1000) != 0, (fdf & 0x2000) != 0, (fdf & 0x4000) != 0, fd_len(dlc & 15u),
                       get<std::uint8_t>(d, p + 2), d.substr(p + 40, next - (p + 40)), report, file, pos)) {
         pos = next;
         continue;
@@ -327,7 +318,7 @@ void write_blf(std::ostream& os, const std::vector<LogEntry>& entries) {
       type = kCanFd;
       put<std::uint16_t>(body, ch);
       put<std::uint8_t>(body, f.remote ? 0x80 : 0);
-      put<std::uint8_t>(body, fd_dlc(f.len));
+      put<std::uint8_t>(body, static_cast<std::uint8_t>(fd_dlc(f.len)));
       put<std::uint32_t>(body, id);
       put<std::uint32_t>(body, 0);
       put<std::uint8_t>(body, 0);

@@ -25,6 +25,18 @@ void drop(LogReadReport* report, const std::string& file, long line, const std::
 /// Splits `line` on blanks (space, tab, CR) into at most `max` fields; returns how many.
 std::size_t split_blank(std::string_view line, std::string_view* out, std::size_t max);
 
+/// CAN FD data length [bytes] of a DLC code (0–8, 12, 16, 20, 24, 32, 48, 64); 0xFF above 15.
+inline std::uint8_t fd_len(std::uint32_t dlc) noexcept {
+  static constexpr std::uint8_t k[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 12, 16, 20, 24, 32, 48, 64};
+  return dlc < 16 ? k[dlc] : 0xFF;
+}
+/// The smallest DLC code whose data length holds `len` bytes (15 above 64).
+inline std::uint32_t fd_dlc(std::uint32_t len) noexcept {
+  for (std::uint32_t d = 0; d < 16; ++d)
+    if (fd_len(d) >= len) return d;
+  return 15;
+}
+
 /// Days since 1970-01-01 of a proleptic Gregorian date (Howard Hinnant's algorithm).
 std::int64_t days_from_civil(std::int64_t y, unsigned m, unsigned d);
 

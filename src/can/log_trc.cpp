@@ -30,15 +30,6 @@ bool millis(std::string_view s, double& t) {
   return r.ec == std::errc() && r.ptr == s.data() + s.size() && std::isfinite(t) && t >= 0;
 }
 
-std::uint8_t fd_len(std::uint32_t dlc) {
-  static constexpr std::uint8_t k[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 12, 16, 20, 24, 32, 48, 64};
-  return dlc < 16 ? k[dlc] : 0xFF;
-}
-std::uint32_t fd_dlc(std::uint32_t len) {
-  for (std::uint32_t d = 0; d < 16; ++d)
-    if (fd_len(d) >= len) return d;
-  return 15;
-}
 
 struct Layout {
   int version = 100;          ///< 100 = 1.0, 101 = 1.1, … 201 = 2.1
