@@ -162,21 +162,26 @@ def run_once(attempt):
     tail = [yy for tt, yy in after if tt >= 2.5]
     before = [yy for tt, yy in zip(t, y) if 0.7 <= tt < 1.0]
     late = ms["frames"]["late"] + ms["frames"]["lost"]
+    # A stall of the python slave long enough for the master's staleness or sensor timeout puts the
+    # master in its degraded or safe state (PI frozen or reset, current ramped or 0 mA): correct,
+    # but the step response is then not the loop's own.
+    safe = [e["event"] for e in ms["events"] if "safe_state" in e["event"] or "degraded" in e["event"]]
     print(f"attempt {attempt}: python-can slave: settling {settling:.3f} s, final mean {sum(tail) / len(tail):.1f} kPa, "
-          f"{stats['sensors']} sensor frames sent, {late} late or lost at the master")
-    return late, settling, tail, before
+          f"{stats['sensors']} sensor frames sent, {late} late or lost at the master, degraded/safe episodes {safe}")
+    return late, safe, settling, tail, before
 
 
 out = tempfile.mkdtemp(prefix="lash_hil_py_")
 # The loop's dynamics are lash's only while the python slave keeps its schedule: a sensor frame
 # late at the master is a delay in the loop, and with the thesis's aggressive gains a few dozen
 # of them (a python thread on a loaded host) stretch the settling. So the step-response figures
-# are asserted on a run whose frames were on time (at most 1 % late); every run must pass the
-# interoperability checks above. A host too busy for any such run is a skip, not a pass.
+# are asserted on a run whose frames were on time (at most 1 % late, no degraded or safe-state episode);
+# every run must pass the interoperability checks above. A host too busy for any such run is a
+# skip, not a pass.
 clean = None
 for attempt in range(1, 4):
-    late, settling, tail, before = run_once(attempt)
-    if late <= 6:
+    late, safe, settling, tail, before = run_once(attempt)
+    if late <= 6 and not safe:
         clean = (settling, tail, before)
         break
 if clean is None:
