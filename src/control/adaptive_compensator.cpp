@@ -123,8 +123,7 @@ PerSide<GateInput> DeadzoneAdapter::step(double v_applied, double y) noexcept {
   const double v1 = v1_;
   v1_ = v_applied;
   est_.step(v_applied, y);
-  if (warm_ > 0 && std::isfinite(v_applied) && std::isfinite(y)) --warm_;  // as the estimator's warm-up
-  if (warm_ == 0) {
+  if (!est_.warming_up()) {
     if (v1 > ecfg_.guess_right) exc_r_.add(v1);
     else if (v1 < ecfg_.guess_left) exc_l_.add(v1);
   }

@@ -110,9 +110,9 @@ EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> 
   run.param_names = est.param_names();
   std::vector<double> pv(run.param_names.size());
   if (keep_trace) run.params.assign(pv.size(), std::vector<double>(n));
-  step_through(est, v, y, 0, n, gap_rows, [&](std::size_t k) {
-    run.yhat.push_back(est.prediction());  // k = run.yhat.size(): step_through goes 0, 1, ..., n - 1
-    run.ysim.push_back(est.simulated());
+  step_through(est, v, y, 0, n, gap_rows, [&](std::size_t k, const auto& e) {
+    run.yhat.push_back(e.prediction());  // k = run.yhat.size(): step_through goes 0, 1, ..., n - 1
+    run.ysim.push_back(e.simulated());
     if (keep_trace) {
       est.param_values(pv);
       for (std::size_t p = 0; p < pv.size(); ++p) run.params[p][k] = pv[p];

@@ -234,7 +234,7 @@ std::array<double, 2> search_guesses(const EstimatorConfig& cfg0, std::span<cons
     cfg.guess_right = g[0] > 0.0 ? g[0] : kInf;
     cfg.guess_left = g[1] < 0.0 ? g[1] : -kInf;
     AnyEstimator est(cfg);
-    step_through(est, v, y, 0, v.size(), gap_rows, [](std::size_t) {});
+    step_through(est, v, y, 0, v.size(), gap_rows, [](std::size_t, const auto&) {});
     std::array<double, 2> next = g;
     for (int i = 0; i < 2; ++i) {
       const Side s = i == 0 ? Side::right : Side::left;

@@ -67,7 +67,7 @@ PerSide<SideIntervals> batch_means_intervals(const EstimatorConfig& cfg, std::sp
   AnyEstimator est(cfg);
   for (std::size_t b = 0; b < B; ++b) {
     est.reset();
-    step_through(est, v, y, b * len, (b + 1) * len, s.gap_rows, [](std::size_t) {});
+    step_through(est, v, y, b * len, (b + 1) * len, s.gap_rows, [](std::size_t, const auto&) {});
     for (Side side : {Side::right, Side::left}) {
       const SideParams p = est.params(side);
       if (!p.identified) continue;

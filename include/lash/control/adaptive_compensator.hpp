@@ -288,7 +288,6 @@ class DeadzoneAdapter {
   void restart() noexcept {
     est_.restart();
     v1_ = 0.0;
-    warm_ = est_.warmup();
   }
   AdaptationReason refine(Side s, AdaptationReason r) const noexcept {
     return (not_excited_[s] && r == AdaptationReason::not_identified) ? AdaptationReason::not_excited : r;
@@ -304,7 +303,6 @@ class DeadzoneAdapter {
   PerSide<double> need_;  // min_excitation_ratio × nominal per side
   detail::Excitation exc_r_, exc_l_;
   double v1_ = 0.0;
-  std::uint32_t warm_ = 0;  // samples of the estimator's warm-up still to go after a restart()
   PerSide<bool> not_excited_{};
 };
 

@@ -93,6 +93,13 @@ class AnyEstimator {
   const EstimatorConfig& config() const noexcept { return cfg_; }
   template <class E>
   const E* get() const noexcept { return std::get_if<E>(&e_); }
+  /// Calls f(estimator) with the concrete estimator, which f steps `n` times (step_through):
+  /// one dispatch for a whole run of samples.
+  template <class F>
+  void visit_steps(std::uint64_t n, F&& f) {
+    samples_ += n;
+    std::visit(std::forward<F>(f), e_);
+  }
 
  private:
   EstimatorConfig cfg_;
@@ -102,22 +109,26 @@ class AnyEstimator {
   std::uint64_t samples_ = 0;
 };
 
-/// Steps `est` through samples [begin, end) of v, y, calling est.restart() before every row listed
+/// Steps `est` through samples [begin, end) of v, y, calling restart() before every row listed
 /// in `gap_rows` (ascending row indices where a gap ends, as Record::gap_rows() / Table::gap_rows;
-/// a gap row outside the range is ignored), and `each(k)` after the step of sample k. The one run
-/// loop of every whole-record estimation (run_estimator, search_guesses, the intervals' sections).
+/// a gap row outside the range is ignored), and `each(k, e)` after the step of sample k, where `e`
+/// is the concrete estimator (LinearEstimator, ...): the variant is dispatched once per call, not
+/// per sample. The one run loop of every whole-record estimation (run_estimator, search_guesses,
+/// the intervals' sections).
 template <class Each>
 void step_through(AnyEstimator& est, std::span<const double> v, std::span<const double> y, std::size_t begin,
                   std::size_t end, std::span<const std::size_t> gap_rows, Each&& each) {
-  auto gap = std::lower_bound(gap_rows.begin(), gap_rows.end(), begin);
-  for (std::size_t k = begin; k < end; ++k) {
-    if (gap != gap_rows.end() && *gap == k) {
-      if (k > begin) est.restart();  // at `begin` the history is already empty (new or reset estimator)
-      ++gap;
+  est.visit_steps(end - begin, [&](auto& e) {
+    auto gap = std::lower_bound(gap_rows.begin(), gap_rows.end(), begin);
+    for (std::size_t k = begin; k < end; ++k) {
+      if (gap != gap_rows.end() && *gap == k) {
+        if (k > begin) e.restart();  // at `begin` the history is already empty (new or reset estimator)
+        ++gap;
+      }
+      e.step(v[k], y[k]);
+      each(k, std::as_const(e));
     }
-    est.step(v[k], y[k]);
-    each(k);
-  }
+  });
 }
 
 /// Result of running an estimator over a whole record.

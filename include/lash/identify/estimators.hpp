@@ -106,6 +106,8 @@ class LinearEstimator {
   void restart() noexcept;
   /// Samples after restart() that update nothing.
   std::uint32_t warmup() const noexcept { return warmup_; }
+  /// True while samples of that warm-up are still to go (after the last step()).
+  bool warming_up() const noexcept { return warm_ > 0; }
 
  private:
   EstimatorConfig cfg_;
@@ -139,6 +141,8 @@ class TwoSideEstimator {
   /// After a gap: clears the signal history, keeps the estimates (see the file comment).
   void restart() noexcept;
   std::uint32_t warmup() const noexcept { return warmup_; }
+  /// True while samples of that warm-up are still to go (after the last step()).
+  bool warming_up() const noexcept { return warm_ > 0; }
 
  protected:
   explicit TwoSideEstimator(const EstimatorConfig& cfg);
@@ -210,6 +214,8 @@ class DeadzoneDeadbandEstimator {
   /// After a gap: clears the signal history, keeps the estimates (see the file comment).
   void restart() noexcept;
   std::uint32_t warmup() const noexcept { return warmup_; }
+  /// True while samples of that warm-up are still to go (after the last step()).
+  bool warming_up() const noexcept { return warm_ > 0; }
 
   double prediction() const noexcept { return yhat_; }
   double simulated() const noexcept { return ysim_; }
@@ -287,6 +293,8 @@ class CoupledCartsEstimator {
   /// After a gap: clears the signal history (and the open slot crossing), keeps the estimates.
   void restart() noexcept;
   std::uint32_t warmup() const noexcept { return warmup_; }
+  /// True while samples of that warm-up are still to go (after the last step()).
+  bool warming_up() const noexcept { return warm_ > 0; }
   double prediction() const noexcept { return yhat_; }
   double simulated() const noexcept { return ysim_; }
   /// Velocity model per side (a1, b1, c) and the shared deadband half-width d.
