@@ -267,8 +267,7 @@ void DeadzoneDeadbandEstimator::restart() noexcept {
   pre_.reset();
   hist_ = {};
   y1_ = v1_ = 0.0;
-  dir1_ = 0;
-  side1_.reset();
+  regime1_ = 0;
   run_ = 0;
   warm_ = warmup_;
 }
@@ -298,8 +297,9 @@ void DeadzoneDeadbandEstimator::restart() noexcept {
   const Side s = detail::free_run_side(vraw1_, sc_, sim_last_, cfg_.sim_side_by_sign);
   sim_last_ = s;
   const double u = detail::deadzone(vraw1_, sc_.left, sc_.right);
-  w_ = -sa1_[s] * w_ + sb1_[s] * u;
-  const double d = sd_[s];
+  const FreeRunSide& m = sim_[s];
+  w_ = -m.a1 * w_ + m.b1 * u;
+  const double d = m.d;
   if (w_ < ysim_ - d) ysim_ = w_ + d;
   else if (w_ > ysim_ + d) ysim_ = w_ - d;
   vraw1_ = v;
@@ -314,8 +314,11 @@ double DeadzoneDeadbandEstimator::step(double v, double y) noexcept {
   const int dir = direction(s.ydot, cfg_.noise.derivative_threshold);
   const double y1 = y1_, v1 = v1_;
   const std::optional<Side> side = detail::guess_side(v1, cfg_);
-  run_ = (dir != 0 && dir == dir1_ && side == side1_) ? run_ + 1 : 1;
-  side1_ = side;
+  // the direction hold: samples in a row with the same moving direction on the same side
+  // (regime 0 = not moving: never counts; one compare instead of two and an optional's)
+  const int regime = dir == 0 ? 0 : dir * (side ? 1 + static_cast<int>(*side) : 3);
+  run_ = (regime != 0 && regime == regime1_) ? run_ + 1 : 1;
+  regime1_ = regime;
   if (warm_ > 0) {  // after a gap (restart()): the direction hold starts again once the history is refilled
     --warm_;
     run_ = 0;
@@ -351,7 +354,6 @@ double DeadzoneDeadbandEstimator::step(double v, double y) noexcept {
   hist_.push(s.y);
   y1_ = s.y;
   v1_ = s.v;
-  dir1_ = dir;
   simulate(v);
   fit_.add(y, ysim_);
   return yhat_;
@@ -439,11 +441,11 @@ void DeadzoneDeadbandEstimator::refresh(Side side) noexcept {
   prev_d_[side] = q.p.d;
   const bool ok = q.usable && settled_[side] >= cfg_.settle_updates;
   usable_[side] = ok;
-  sa1_[side] = q.p.a1;
-  sb1_[side] = q.p.b1;
+  sim_[side].a1 = q.p.a1;
+  sim_[side].b1 = q.p.b1;
   if (ok) {
     sc_[side] = q.p.c;
-    sd_[side] = q.p.d > 0.0 ? q.p.d : 0.0;
+    sim_[side].d = q.p.d > 0.0 ? q.p.d : 0.0;
   }
 }
 

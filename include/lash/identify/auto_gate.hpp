@@ -31,27 +31,25 @@ class OutlierGate {
   double step(double y) noexcept {
     if (!std::isfinite(y)) return y;
     if (n_ < 2) {
-      y2_ = y1_;
       y1_ = y;
       ++n_;
       return y;
     }
     const double pred = y1_;  // local-level prediction (a slope term doubles the noise gain)
-    const double e = y - pred;
-    const double ae = std::fabs(e);
-    const bool ready = c_.gate > 0.0 && n_ >= c_.warmup && scale_ > 0.0;
-    if (ready && !held_ && ae > c_.gate * scale_) {
+    const double ae = std::fabs(y - pred);
+    const bool warm = n_ >= c_.warmup;
+    const double bound = c_.gate * scale_;  // finite while scale_ is; a NaN compares false below
+    if (warm && !held_ && c_.gate > 0.0 && scale_ > 0.0 && ae > bound) {
       held_ = true;
       ++rejected_;
-      y2_ = y1_;
       return pred;  // y1_ stays: the next sample is compared with the last accepted one
     }
     held_ = false;
-    const double clip = scale_ > 0.0 && n_ >= c_.warmup ? std::fmin(ae, c_.gate * scale_) : ae;
-    const double a = n_ < c_.warmup ? 1.0 / static_cast<double>(n_) : c_.alpha;
+    // the scale follows min(|e|, bound) once warm (as std::fmin: ae is never NaN here)
+    const double clip = warm && scale_ > 0.0 && bound < ae ? bound : ae;
+    const double a = warm ? c_.alpha : 1.0 / static_cast<double>(n_);
     scale_ += a * (clip - scale_);
     ++n_;
-    y2_ = y1_;
     y1_ = y;
     return y;
   }
@@ -61,7 +59,7 @@ class OutlierGate {
 
  private:
   OutlierGateConfig c_;
-  double y1_ = 0.0, y2_ = 0.0, scale_ = 0.0;
+  double y1_ = 0.0, scale_ = 0.0;
   std::uint64_t n_ = 0, rejected_ = 0;
   bool held_ = false;
 };

@@ -254,7 +254,11 @@ class DeadzoneDeadbandEstimator {
   PerSide<Rls<4>> pooled_;
   std::array<std::uint64_t, 4> count_{};
   PerSide<bool> usable_{};
-  PerSide<double> sa1_{}, sb1_{}, sc_{}, sd_{};
+  struct FreeRunSide {  // the free-run model of a side, read together on every sample
+    double a1 = 0.0, b1 = 0.0, d = 0.0;
+  };
+  PerSide<FreeRunSide> sim_{};
+  PerSide<double> sc_{};
   PerSide<double> prev_c_{}, prev_d_{};
   PerSide<std::uint32_t> settled_{};
   PerSide<std::uint32_t> since_{};
@@ -262,9 +266,8 @@ class DeadzoneDeadbandEstimator {
   detail::History hist_;
   detail::FitWindow fit_;
   double y1_ = 0.0, v1_ = 0.0, vraw1_ = 0.0, w_ = 0.0;
-  int dir1_ = 0;
   Side last_ = Side::right, sim_last_ = Side::right;
-  std::optional<Side> side1_;
+  int regime1_ = 0;  // the last sample's regime(): direction of motion and guess side together
   std::uint32_t run_ = 0;
   std::uint32_t warmup_ = 0, warm_ = 0;
   double yhat_ = 0.0, ysim_ = 0.0;

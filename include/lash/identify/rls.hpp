@@ -145,13 +145,13 @@ class Rls {
   /// q = Pz/(λ + φᵀPz), η += q(y − φᵀη), P = (P − qφᵀP)/λ. P is not symmetric in this
   /// mode (it estimates (Σ z φᵀ)⁻¹). Exponential forgetting and the trace bound apply.
   double update_iv(const Vec& phi, const Vec& z, double y) noexcept {
+#if defined(__GNUC__)
+    if constexpr (N == 4) return update_iv4(phi, z, y);
+#endif
     if (!finite(phi, y) || !finite(z, 0.0)) {
       ++skipped_;
       return std::numeric_limits<double>::quiet_NaN();
     }
-#if defined(__GNUC__)
-    if constexpr (N == 4) return update_iv4(phi, z, y);
-#endif
     const double yhat = predict(phi);
     Vec pz{}, phip{};  // P z and φᵀ P
     for (std::size_t i = 0; i < N; ++i) {
@@ -201,10 +201,12 @@ class Rls {
   const RlsConfig<N>& config() const noexcept { return cfg_; }
 
  private:
+  /// All of phi and y finite: x·0 is 0 for a finite x and NaN for ±inf or NaN, so the sum is 0
+  /// exactly when every term is finite (no branch per element).
   static bool finite(const Vec& phi, double y) noexcept {
-    bool ok = std::isfinite(y);
-    for (std::size_t i = 0; i < N; ++i) ok = ok && std::isfinite(phi[i]);
-    return ok;
+    double s = y * 0.0;
+    for (std::size_t i = 0; i < N; ++i) s += phi[i] * 0.0;
+    return s == 0.0;
   }
   /// φᵀPφ for symmetric P: the φ products do not depend on P, and the terms are added
   /// pairwise, so the chain from P(k−1) to the division is short (see bench/bench_identify.cpp).
@@ -236,6 +238,15 @@ class Rls {
       return r;
     };
     auto store = [](double* a, v2 r) noexcept { std::memcpy(a, &r, sizeof r); };
+    // finite(phi, y) && finite(z): x·0 is 0 for a finite x and NaN for ±inf or NaN, so the sum of
+    // the nine products is 0 exactly when all nine are finite (four vector products, no branch each)
+    const v2 zero = {0.0, 0.0};
+    const v2 nf = ((v2{phi[0], phi[1]} * zero + v2{phi[2], phi[3]} * zero) +
+                   (v2{z[0], z[1]} * zero + v2{z[2], z[3]} * zero)) + v2{y, 0.0} * zero;
+    if (!(nf[0] + nf[1] == 0.0)) {
+      ++skipped_;
+      return std::numeric_limits<double>::quiet_NaN();
+    }
     const double yhat = predict(phi);
     v2 lo[4], hi[4];  // row i: [P_i0, P_i1], [P_i2, P_i3]
     for (std::size_t i = 0; i < 4; ++i) {
