@@ -75,6 +75,9 @@ def run_serial(files):
 # from the heap again, which is still trimmed beyond 32 MiB free. For workers started by hand
 # (dask-worker, dask-ssh, Slurm), set the same two variables in their environment.
 WORKER_ENV = {"MALLOC_MMAP_THRESHOLD_": "16777216", "MALLOC_TRIM_THRESHOLD_": "33554432"}
+# Dask's statistical profiler samples every thread's stack each 10 ms in every worker (for the
+# dashboard's profile page): with lash doing the work, that sampling was 5-8 % of a worker's CPU.
+WORKER_CONFIG = {"distributed.worker.profile.enabled": False}
 
 
 def local_cluster(workers=None):
@@ -82,7 +85,9 @@ def local_cluster(workers=None):
     import dask
     from dask.distributed import LocalCluster
 
-    with dask.config.set({"distributed.nanny.pre-spawn-environ." + k: v for k, v in WORKER_ENV.items()}):
+    settings = {"distributed.nanny.pre-spawn-environ." + k: v for k, v in WORKER_ENV.items()}
+    settings.update(WORKER_CONFIG)
+    with dask.config.set(settings):
         return LocalCluster(n_workers=workers or os.cpu_count(), threads_per_worker=1, processes=True,
                             dashboard_address=None)
 
@@ -106,20 +111,24 @@ def run_dask(files, scheduler=None, workers=None):
 
 
 def identify_batch(paths, settings=SETTINGS):
-    """Several records in one task -> their rows in order (one record takes only ~10-30 ms: one task
-    per record would spend a large part of the time in Dask's per-task scheduling)."""
-    return [row for p in paths for row in identify(p, settings)]
+    """Several records in one task -> their rows, a list per record (one record takes only ~10-30 ms:
+    one task per record would spend a large part of the time in Dask's per-task scheduling)."""
+    return [identify(p, settings) for p in paths]
 
 
 def identify_on(client, files, batches_per_worker=4):
-    """Identifies every file on a connected dask.distributed Client: the files in consecutive batches,
-    `batches_per_worker` per worker (enough to even out the load, few enough that each task is long)."""
+    """Identifies every file on a connected dask.distributed Client: the files dealt round-robin into
+    `batches_per_worker` batches per worker (enough to even out the load, few enough that each task is
+    long; dealt, not cut in runs, so that every batch holds early and late records of the fleet alike
+    and no worker is left with the slowest stretch at the end). Rows in file order."""
     workers = max(1, len(client.scheduler_info().get("workers", {})))
     n = max(1, min(len(files), workers * batches_per_worker))
-    size = -(-len(files) // n)
-    batches = [files[i:i + size] for i in range(0, len(files), size)]
+    batches = [files[i::n] for i in range(n)]
     futures = client.map(identify_batch, batches, pure=False)
-    return [row for rows in client.gather(futures) for row in rows]
+    per_file = [None] * len(files)
+    for i, batch in enumerate(client.gather(futures)):
+        per_file[i::n] = batch  # batch i holds files i, i + n, i + 2n, ...
+    return [row for rows in per_file for row in rows]
 
 
 def write_csv(path, rows):
