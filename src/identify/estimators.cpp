@@ -12,7 +12,8 @@ const EstimatorConfig& checked(const EstimatorConfig& c) {
   c.validate();
   return c;
 }
-bool finite_all(double a, double b) noexcept { return std::isfinite(a) && std::isfinite(b); }
+// x·0 is ±0 for a finite x and NaN for ±inf or NaN: one compare for both, no branch each
+bool finite_all(double a, double b) noexcept { return a * 0.0 + b * 0.0 == 0.0; }
 
 /// Whether a side's estimate (a1, b1, e) with deadzone edge c may drive the free-run simulation:
 /// finite and stable (|a1| < 1: a1 ≤ −1 integrates or diverges, and such a transient made E3/E4
@@ -50,7 +51,7 @@ void LinearEstimator::restart() noexcept {
 }
 
 double LinearEstimator::step(double v, double y) noexcept {
-  if (!finite_all(v, y)) {
+  if (!finite_all(v, y)) [[unlikely]] {
     ++skipped_;
     return yhat_ = kNaN;
   }
@@ -174,7 +175,7 @@ void InputDeadzoneEstimator::refresh(Side s) noexcept {
 }
 
 double InputDeadzoneEstimator::step(double v, double y) noexcept {
-  if (!finite_all(v, y)) {
+  if (!finite_all(v, y)) [[unlikely]] {
     ++skipped_;
     return yhat_ = kNaN;
   }
@@ -213,7 +214,7 @@ void OutputDeadzoneEstimator::refresh(Side s) noexcept {
 }
 
 double OutputDeadzoneEstimator::step(double v, double y) noexcept {
-  if (!finite_all(v, y)) {
+  if (!finite_all(v, y)) [[unlikely]] {
     ++skipped_;
     return yhat_ = kNaN;
   }
@@ -306,7 +307,7 @@ void DeadzoneDeadbandEstimator::restart() noexcept {
 }
 
 double DeadzoneDeadbandEstimator::step(double v, double y) noexcept {
-  if (!finite_all(v, y)) {
+  if (!finite_all(v, y)) [[unlikely]] {
     ++skipped_;
     return yhat_ = kNaN;
   }
@@ -319,7 +320,7 @@ double DeadzoneDeadbandEstimator::step(double v, double y) noexcept {
   const int regime = dir == 0 ? 0 : dir * (side ? 1 + static_cast<int>(*side) : 3);
   run_ = (regime != 0 && regime == regime1_) ? run_ + 1 : 1;
   regime1_ = regime;
-  if (warm_ > 0) {  // after a gap (restart()): the direction hold starts again once the history is refilled
+  if (warm_ > 0) [[unlikely]] {  // after a gap (restart()): the direction hold starts again once the history is refilled
     --warm_;
     run_ = 0;
   }
@@ -346,7 +347,7 @@ double DeadzoneDeadbandEstimator::step(double v, double y) noexcept {
     yrange_[sd].add(y1);
     // Derived (a1, b1, c, d) are refreshed on every update until the side is usable, then
     // every 8th update (the free run lags at most 7 updates; params() is always current).
-    if (!usable_[sd] || (++since_[sd] & 7u) == 0) refresh(sd);
+    if (!usable_[sd] || (++since_[sd] & 7u) == 0) [[unlikely]] refresh(sd);
     last_ = sd;
   } else {
     yhat_ = predict_free(side ? *side : last_, y1, v1);
@@ -554,7 +555,7 @@ bool CoupledCartsEstimator::identified() const noexcept {
 }
 
 double CoupledCartsEstimator::step(double v, double y) noexcept {
-  if (!finite_all(v, y)) {
+  if (!finite_all(v, y)) [[unlikely]] {
     ++skipped_;
     return yhat_ = kNaN;
   }

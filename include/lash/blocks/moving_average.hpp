@@ -23,7 +23,7 @@ class MovingAverage {
     buf_[pos_] = x;
     head_ += x;
     const double out = (head_ + buf_[n_ + pos_]) * inv_len_;  // buf_[n_ + p]: Σ old[p+1 .. M−1]
-    if (++pos_ == n_) next_block();
+    if (++pos_ == n_) [[unlikely]] next_block();
     return out;
   }
   void reset() noexcept;
@@ -66,7 +66,7 @@ class MovingAveragePair {
     buf[pos_] = x;
     head_ += x;
     const v2 out = (head_ + buf[n_ + pos_]) * inv_len_;
-    if (++pos_ == n_) next_block();
+    if (++pos_ == n_) [[unlikely]] next_block();
     mean_a = out[0];
     mean_b = out[1];
   }

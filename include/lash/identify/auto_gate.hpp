@@ -29,8 +29,8 @@ class OutlierGate {
   /// Returns y, or its extrapolation when y is an isolated outlier. Non-finite y passes unchanged
   /// (the estimators skip and count it).
   double step(double y) noexcept {
-    if (!std::isfinite(y)) return y;
-    if (n_ < 2) {
+    if (!std::isfinite(y)) [[unlikely]] return y;
+    if (n_ < 2) [[unlikely]] {
       y1_ = y;
       ++n_;
       return y;
@@ -39,7 +39,7 @@ class OutlierGate {
     const double ae = std::fabs(y - pred);
     const bool warm = n_ >= c_.warmup;
     const double bound = c_.gate * scale_;  // finite while scale_ is; a NaN compares false below
-    if (warm && !held_ && c_.gate > 0.0 && scale_ > 0.0 && ae > bound) {
+    if (warm && !held_ && c_.gate > 0.0 && scale_ > 0.0 && ae > bound) [[unlikely]] {
       held_ = true;
       ++rejected_;
       return pred;  // y1_ stays: the next sample is compared with the last accepted one

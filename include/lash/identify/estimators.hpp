@@ -71,7 +71,12 @@ constexpr std::optional<Side> guess_side(double v1, const EstimatorConfig& c) no
 struct FitWindow {
   std::uint64_t k0 = 0, k = 0;
   NrmseAccumulator window, before;  // t ≥ fit_start_s, and the samples before it
-  void add(double y, double ysim) noexcept { (k++ >= k0 ? window : before).add(y, ysim); }
+  void add(double y, double ysim) noexcept {
+    if (k++ >= k0) [[likely]]
+      window.add(y, ysim);
+    else
+      before.add(y, ysim);
+  }
   /// The window's NRMSE; the whole record's when it ended before the window began.
   double nrmse() const noexcept { return window.n > 0 ? window.value() : before.value(); }
 };

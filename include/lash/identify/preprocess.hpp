@@ -28,7 +28,7 @@ class Preprocessor {
   Preprocessor(const NoiseSettings& s, double dt_s);
 
   Conditioned step(double v, double y) noexcept {
-    if (identity_) {
+    if (identity_) [[unlikely]] {
       const double d = (y - y_prev_) * inv_dt_;
       y_prev_ = y;
       return {v, y, d};

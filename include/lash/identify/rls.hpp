@@ -243,7 +243,7 @@ class Rls {
     const v2 zero = {0.0, 0.0};
     const v2 nf = ((v2{phi[0], phi[1]} * zero + v2{phi[2], phi[3]} * zero) +
                    (v2{z[0], z[1]} * zero + v2{z[2], z[3]} * zero)) + v2{y, 0.0} * zero;
-    if (!(nf[0] + nf[1] == 0.0)) {
+    if (!(nf[0] + nf[1] == 0.0)) [[unlikely]] {
       ++skipped_;
       return std::numeric_limits<double>::quiet_NaN();
     }
