@@ -2,7 +2,8 @@
 """Speed of the lash Python package, as ratios printed in one run (docs/python.md):
 
 1. lash.estimate on 10^6 samples from numpy arrays, per sample, against two C++ Google Benchmarks
-   on the same plant data, Python and C++ alternating `--rounds` times (each side the best of 5 calls;
+   on the same plant data, Python and C++ alternating `--rounds` times, each round pinned to one
+   vCPU, the vCPUs in turn (each side the best of 5 calls;
    the median of the per-round ratios printed): BM_EstimateArrays (bench_estimate_auto.cpp: the same library call, lash::estimate_arrays,
    on the same 10^6 samples; goal: ratio <= 1.2, i.e. no per-sample Python work) and
    BM_DeadzoneDeadband (bench_identify.cpp: the bare estimator step alone, data in cache). Timed with
@@ -106,11 +107,17 @@ def main():
     # Python and C++ alternate, `rounds` times, so that a change of the host's load hits both; the
     # ratios are taken within each round and their median printed.
     # Each side of a round: the best of 5 calls (an other job's time slice only ever adds time).
+    # Each round runs on one vCPU (this process pinned to it; lash_bench inherits the pinning), the
+    # vCPUs taken in turn: on a shared host one vCPU can run this code much slower than the other
+    # for minutes (docs/identification.md, "Speed"), and an unpinned process stays where it started.
+    cpus = sorted(os.sched_getaffinity(0))
     rows = []
-    for _ in range(args.rounds):
+    for r in range(args.rounds):
+        os.sched_setaffinity(0, {cpus[r % len(cpus)]})
         py_ns = best_of(lambda: lash.estimate(t, v, y, **same), 5) / n * 1e9
         cpp = cpp_ns_per_sample(args.lash_bench, ["BM_EstimateArrays", "BM_DeadzoneDeadband"], 5) if have_cpp else {}
         rows.append((py_ns, cpp))
+    os.sched_setaffinity(0, set(cpus))
     py_ns = statistics.median(r[0] for r in rows)
     full_ns = median_of(lambda: lash.estimate(t, v, y, **settings), 3) / n * 1e9
     print("1. lash.estimate, deadzone-deadband, 10^6 samples from numpy: %.2f ns/sample (%.1f M samples/s) with the"
