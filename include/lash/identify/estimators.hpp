@@ -272,7 +272,7 @@ class DeadzoneDeadbandEstimator {
   detail::FitWindow fit_;
   double y1_ = 0.0, v1_ = 0.0, vraw1_ = 0.0, w_ = 0.0;
   Side last_ = Side::right, sim_last_ = Side::right;
-  int regime1_ = 0;  // the last sample's regime(): direction of motion and guess side together
+  int regime1_ = 0;  // the last sample's regime (step()): direction of motion × guess side, 0 = not moving
   std::uint32_t run_ = 0;
   std::uint32_t warmup_ = 0, warm_ = 0;
   double yhat_ = 0.0, ysim_ = 0.0;
