@@ -13,6 +13,7 @@
 #include "lash/control/gains_file.hpp"
 #include "lash/io/csv.hpp"
 #include "lash/io/error.hpp"
+#include "lash/io/field_table.hpp"
 
 namespace lash {
 
@@ -61,13 +62,6 @@ const ControllerField kFields[] = {
 // clang-format on
 constexpr std::size_t kN = std::size(kFields);
 constexpr const char* kTables[] = {"pid", "deadzone_inverse", "saturation"};
-
-template <class... F>
-struct Overload : F... {
-  using F::operator()...;
-};
-template <class... F>
-Overload(F...) -> Overload<F...>;
 
 std::size_t index_of(std::string_view table, std::string_view key) {
   for (std::size_t i = 0; i < kN; ++i)
@@ -153,10 +147,7 @@ void read_value(TomlTable& t, const std::string& key, const ControllerField& f, 
 std::span<const ControllerField> controller_fields() noexcept { return kFields; }
 
 const ControllerField* find_controller_field_by_flag(std::string_view flag) noexcept {
-  if (flag.empty()) return nullptr;
-  for (const auto& f : kFields)
-    if (flag == f.flag) return &f;
-  return nullptr;
+  return find_by_flag<ControllerField>(kFields, flag);
 }
 
 bool controller_field_is_name(const ControllerField& f) noexcept {

@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <type_traits>
 
+#include "lash/io/field_table.hpp"
+
 namespace lash {
 
 static_assert(std::is_same_v<std::size_t, std::uint64_t>, "min_updates is referenced as std::size_t*");
@@ -108,13 +110,6 @@ const ConfigField kFields[] = {
 };
 // clang-format on
 
-template <class... F>
-struct Overload : F... {
-  using F::operator()...;
-};
-template <class... F>
-Overload(F...) -> Overload<F...>;
-
 void parse_enum(std::string_view s, ModelKind& m) { m = parse_model_kind(s); }
 void parse_enum(std::string_view s, EstimationMethod& m) { m = parse_method(s); }
 void parse_enum(std::string_view s, Forgetting& f) { f = parse_forgetting(s); }
@@ -173,10 +168,7 @@ std::string toml_string(std::string_view s) {
 std::span<const ConfigField> estimator_fields() noexcept { return kFields; }
 
 const ConfigField* find_field_by_flag(std::string_view flag) noexcept {
-  if (flag.empty()) return nullptr;
-  for (const auto& f : kFields)
-    if (flag == f.flag) return &f;
-  return nullptr;
+  return find_by_flag<ConfigField>(kFields, flag);
 }
 
 bool model_uses(ModelKind model, std::string_view flag) noexcept {
