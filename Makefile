@@ -4,7 +4,7 @@ BUILD_CLANG ?= build-clang
 CMAKE_FLAGS ?=
 JOBS        ?= $(shell nproc)
 
-.PHONY: all deps configure build build-clang demo test bench clean
+.PHONY: all deps configure build build-clang demo test fuzz bench clean
 
 all: build
 
@@ -20,7 +20,8 @@ configure: $(BUILD)/build.ninja
 build: deps configure
 	cmake --build $(BUILD) -j $(JOBS)
 
-# The clang build: proves -Wall -Wextra -Werror on clang 14 and feeds the
+# The clang build: proves -Wall -Wextra -Werror on clang 14, runs the unit suite under UBSan
+# (-fsanitize=undefined, any report fatal), builds the fuzz targets and feeds the
 # cross-compiler determinism test (same seed -> byte-identical CSV).
 build-clang: deps
 	@test -f $(BUILD_CLANG)/build.ninja || cmake -S . -B $(BUILD_CLANG) -G Ninja -DCMAKE_BUILD_TYPE=Release \
@@ -34,6 +35,11 @@ demo: build
 
 test: build build-clang
 	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
+	ctest --test-dir $(BUILD_CLANG) --output-on-failure -j $(JOBS) -L unit
+
+# Random exploration of every fuzz target, FUZZ_SECONDS each (default 600): docs/fuzzing.md.
+fuzz: build-clang
+	BUILD_CLANG=$(BUILD_CLANG) bash scripts/fuzz.sh
 
 bench: build
 	$(BUILD)/bin/lash_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true

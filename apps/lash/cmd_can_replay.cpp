@@ -7,6 +7,7 @@
 #include "lash/can/bus.hpp"
 #include "lash/can/log.hpp"
 #include "lash/can/replay.hpp"
+#include "lash/io/error.hpp"
 
 namespace lash::cli::can_cmd {
 namespace {
@@ -55,9 +56,17 @@ int run_convert(const ConvertArgs& a) {
 std::vector<can::LogEntry> read_log_reporting(const std::string& path, const char* who) {
   can::LogReadReport report;
   auto entries = can::read_log(path, &report);
-  for (const auto& p : report.problems) fmt::print(stderr, "lash can {}: dropped: {}\n", who, p);
+  constexpr std::size_t kShown = 20;  // a binary file is thousands of bad "lines": the count says the rest
+  for (std::size_t i = 0; i < report.problems.size() && i < kShown; ++i) {
+    const std::string& p = report.problems[i];
+    fmt::print(stderr, "lash can {}: dropped: {}\n", who, p.size() <= 200 ? p : p.substr(0, 200) + "\u2026");
+  }
+  if (report.problems.size() > kShown)
+    fmt::print(stderr, "lash can {}: ... and {} more dropped records\n", who, report.problems.size() - kShown);
   if (report.dropped)
     fmt::print(stderr, "lash can {}: {} of {} records of {} dropped\n", who, report.dropped, report.dropped + entries.size(), path);
+  if (entries.empty() && report.dropped)
+    throw InputError(path, 0, "", "no valid frame: all " + std::to_string(report.dropped) + " records were dropped (not a CAN log?)");
   return entries;
 }
 

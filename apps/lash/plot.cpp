@@ -6,6 +6,7 @@
 
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -25,11 +26,24 @@ void run_gnuplot(const std::string& script_in, const std::string& png_path) {
     throw InputError(png_path, 0, "--plot", "cannot write: directory " + dir.string() + " does not exist");
   if (::access(dir.c_str(), W_OK) != 0)
     throw InputError(png_path, 0, "--plot", "cannot write in directory " + dir.string() + ": " + std::strerror(errno));
-  const std::string tmp_png = png_path + ".tmp." + std::to_string(::getpid()) + ".png";
+  // gnuplot's script and picture go to a fresh private directory next to the target (mkdtemp:
+  // created exclusively, mode 0700), so nothing planted at a predictable name is followed.
+  std::string dir_template = png_path + ".tmp.XXXXXX";
+  if (!::mkdtemp(dir_template.data()))
+    throw InputError(png_path, 0, "--plot", "cannot create a temporary directory next to it: " + std::string(std::strerror(errno)));
+  const std::filesystem::path work(dir_template);
+  struct RemoveDir {
+    std::filesystem::path d;
+    ~RemoveDir() {
+      std::error_code e;
+      std::filesystem::remove_all(d, e);
+    }
+  } cleanup{work};
+  const std::string tmp_png = (work / "plot.png").string();
   std::string script = script_in;
   for (auto pos = script.find("<OUTPUT>"); pos != std::string::npos; pos = script.find("<OUTPUT>"))
     script.replace(pos, 8, tmp_png);
-  const std::string gp = png_path + ".tmp." + std::to_string(::getpid()) + ".gp";
+  const std::string gp = (work / "plot.gp").string();
   {
     std::ofstream f(gp);
     f << script;
@@ -46,9 +60,7 @@ void run_gnuplot(const std::string& script_in, const std::string& png_path) {
     status = ::pclose(p);
   }
   std::error_code ec;
-  std::filesystem::remove(gp, ec);
   if (status != 0 || !std::filesystem::exists(tmp_png)) {
-    std::filesystem::remove(tmp_png, ec);
     if (status != -1 && WIFEXITED(status) && WEXITSTATUS(status) == 127)
       throw InputError(png_path, 0, "--plot", "gnuplot not found on PATH (install gnuplot-nox): " + out);
     throw InputError(png_path, 0, "--plot", "gnuplot failed: " + out);

@@ -562,8 +562,9 @@ inline std::uint64_t MessageCodec::lane_raw(const Lane& l, double p, std::uint32
     const double r = (q + m) - m;
     // |q·(1/f) − q/f| ≤ 3·2^-53·|q|; for |q| ≤ (largest raw + 1) half_tol keeps that gap
     // away from a tie (see the constructor); a larger |q| leaves the field and takes the
-    // reference path below. NaN fails this test.
-    if (std::fabs(q - r) < l.half_tol) [[likely]] {
+    // reference path below. NaN fails this test. Beyond 2^52, q + m − m = q is integral and
+    // passes the first test (e.g. q = −8.8e302): the second keeps the conversion defined.
+    if (std::fabs(q - r) < l.half_tol && std::fabs(r) <= 4503599627370496.0) [[likely]] {
       const auto ir = static_cast<std::int64_t>(r);  // |r| ≤ 2^52 here
       if (static_cast<std::uint64_t>(ir) - static_cast<std::uint64_t>(l.raw_lo) <= l.raw_span) [[likely]]
         return static_cast<std::uint64_t>(ir) & l.mask;

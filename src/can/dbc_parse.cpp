@@ -604,9 +604,18 @@ class Parser {
     apply_long_names();
   }
 
-  /// Vector tools keep names over 32 characters in SystemSignalLongSymbol /
-  /// SystemMessageLongSymbol attributes; the long name is the name (as canmatrix and cantools read it).
+  /// Vector tools keep names over 32 characters in SystemNodeLongSymbol, SystemMessageLongSymbol,
+  /// SystemSignalLongSymbol and SystemEnvVarLongSymbol attributes; the long name is the name (as
+  /// CANdb++, canmatrix and cantools read it), wherever the short one is used.
   void apply_long_names() {
+    for (std::size_t i = 0; i < db_.attributes.size(); ++i) {
+      const Attribute& a = db_.attributes[i];
+      if (a.name == "SystemNodeLongSymbol" && a.object == "BU_") {
+        rename_node(std::string(a.node), std::string(a.value.text));
+      } else if (a.name == "SystemEnvVarLongSymbol" && a.object == "EV_") {
+        rename_env_var(std::string(a.node), std::string(a.value.text));
+      }
+    }
     for (auto& a : db_.attributes) {
       if (a.name == "SystemMessageLongSymbol" && a.object == "BO_") {
         if (Message* m = find_message(a.message_dbc_id)) m->name = a.value.text;
@@ -622,6 +631,39 @@ class Parser {
           if (b.object == "SG_" && b.signal == old && find_message(b.message_dbc_id) == m) b.signal = a.value.text;
       }
     }
+  }
+
+  /// The node `from` is called `to`: in BU_, as transmitter and receiver, in comments and attributes.
+  void rename_node(const std::string& from, const std::string& to) {
+    if (from == to || to.empty()) return;
+    for (auto& n : db_.nodes)
+      if (n == from) n = to;
+    for (auto& m : db_.messages) {
+      if (m.transmitter == from) m.transmitter = to;
+      for (auto& sg : m.signals)
+        for (auto& r : sg.receivers)
+          if (r == from) r = to;
+    }
+    for (auto& c : db_.node_comments)
+      if (c.node == from) c.node = to;
+    for (auto& b : db_.attributes)
+      if (b.object == "BU_" && b.node == from) b.node = to;
+  }
+
+  /// The environment variable `from` is called `to`: in its EV_ statement (kept verbatim) and attributes.
+  void rename_env_var(const std::string& from, const std::string& to) {
+    if (from == to || to.empty()) return;
+    for (auto& text : db_.other_statements) {
+      // "EV_ name : ..." (blanks around the name as written)
+      if (text.rfind("EV_", 0) != 0 || text.size() < 4 || (text[3] != ' ' && text[3] != '\t')) continue;
+      const std::size_t b = text.find_first_not_of(" \t", 3);
+      if (b == std::string::npos || text.compare(b, from.size(), from) != 0) continue;
+      const std::size_t e = b + from.size();
+      if (e < text.size() && text[e] != ' ' && text[e] != '\t' && text[e] != ':') continue;
+      text.replace(b, from.size(), to);
+    }
+    for (auto& b : db_.attributes)
+      if (b.object == "EV_" && b.node == from) b.node = to;
   }
 
   void message() {
@@ -880,8 +922,17 @@ class Parser {
 
 Database parse_dbc(std::string_view text, const std::string& file, const ParseOptions& options,
                    std::vector<Diagnostic>* diagnostics) {
-  Parser p(text, file, options, diagnostics);
-  return p.run();
+  std::vector<Diagnostic> local;
+  std::vector<Diagnostic>* diags = diagnostics ? diagnostics : &local;
+  const std::size_t before = diags->size();
+  Parser p(text, file, options, diags);
+  Database db = p.run();
+  // Tolerant reading keeps what it can; when that is nothing at all, the file is no DBC.
+  if (db == Database{} && diags->size() > before)
+    throw InputError(file, 0, "",
+                     fmt::format("no DBC statement could be read ({} problems, e.g. line {}: {}): not a DBC file?",
+                                 diags->size() - before, (*diags)[before].line, (*diags)[before].message));
+  return db;
 }
 
 std::string Diagnostic::format() const {

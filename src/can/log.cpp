@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include <fmt/core.h>
@@ -365,8 +366,11 @@ std::optional<LogEntry> parse_log_line(std::string_view line, std::string& error
 }
 
 std::string format_log_line(const Frame& frame, std::string_view interface) {
+  // A time candump cannot hold (writable_times) is written as 0: write_log refuses such frames
+  // before it gets here; a live dump's times come from the clock.
   double t = frame.timestamp_s;
-  if (!(t >= 0) || !std::isfinite(t)) t = 0;
+  const TimeSpan span = writable_times(LogFormat::candump);
+  if (!(t >= span.min_abs_s && t < span.max_abs_s)) t = 0;
   auto sec = static_cast<std::uint64_t>(std::floor(t));
   auto us = static_cast<std::uint64_t>(std::llround((t - static_cast<double>(sec)) * 1e6));
   if (us >= 1000000) {
@@ -443,7 +447,46 @@ std::vector<LogEntry> read_log(const std::filesystem::path& path, LogReadReport*
   }
 }
 
+TimeSpan writable_times(LogFormat format) noexcept {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  switch (format) {
+    // Offsets from the earliest frame as decimal text (seconds, milliseconds): any finite.
+    case LogFormat::asc:
+    case LogFormat::trc: return {-inf, inf, inf};
+    // Header date: a SYSTEMTIME whose year is a uint16 (before 65536-01-01 = 2005949145600 s);
+    // object times: uint64 nanoseconds from the header's start (offsets below 2^64 ns, with
+    // room for the rounding); before 1990 the start is 0 and times are offsets from it.
+    case LogFormat::blf: return {0.0, 2005949145600.0, 18446744073.0};
+    // "(seconds.microseconds)" with at most 12 digits of seconds, as read_log takes them.
+    default: return {0.0, 1e12, inf};
+  }
+}
+
+void check_writable_times(const std::vector<LogEntry>& entries, LogFormat format, const std::string& file) {
+  if (entries.empty()) return;
+  const TimeSpan span = writable_times(format);
+  double t0 = entries.front().frame.timestamp_s;
+  for (const auto& e : entries) t0 = std::min(t0, e.frame.timestamp_s);
+  // BLF writes offsets from its header's start, the others from the earliest frame.
+  const bool t0_ok = std::isfinite(t0) && t0 >= span.min_abs_s && t0 < span.max_abs_s;
+  const double origin = format == LogFormat::blf ? (t0_ok ? detail::blf_start_of(t0) : 0.0) : t0;
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    const double t = entries[i].frame.timestamp_s;
+    const double offset = t - origin;
+    const char* why = nullptr;
+    if (!std::isfinite(t)) why = "is not a finite number";
+    else if (t < span.min_abs_s || t >= span.max_abs_s) why = "is outside the times the format can hold";
+    else if (!(offset < span.max_offset_s) || !std::isfinite(offset)) why = "lies too far from the log's earliest frame";
+    if (why)
+      throw InputError(file, 0, fmt::format("frame {}", i + 1),
+                       fmt::format("timestamp {} s {} for {} (times from {} s to {} s, at most {} s after the earliest frame at {} s); "
+                                   "nothing written",
+                                   t, why, to_string(format), span.min_abs_s, span.max_abs_s, span.max_offset_s, t0));
+  }
+}
+
 void write_log(const std::filesystem::path& path, const std::vector<LogEntry>& entries) {
+  check_writable_times(entries, log_format_of(path), path.string());
   AtomicFile f(path);
   switch (log_format_of(path)) {
     case LogFormat::asc: detail::write_asc(f.stream(), entries); break;

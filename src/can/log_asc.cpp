@@ -164,6 +164,7 @@ std::vector<LogEntry> parse_asc(std::string_view text, const std::string& file, 
 }
 
 void write_asc(std::ostream& os, const std::vector<LogEntry>& entries) {
+  check_writable_times(entries, LogFormat::asc, "");
   os << "date Thu Jan 01 00:00:00.000 am 1970\nbase hex  timestamps absolute\ninternal events logged\n";
   os << "// version 9.0.0\nBegin Triggerblock Thu Jan 01 00:00:00.000 am 1970\n";
   os << fmt::format("{: 9.6f} Start of measurement\n", 0.0);

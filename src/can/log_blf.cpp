@@ -69,7 +69,6 @@ void put_systemtime(std::string& d, double t) {
   for (auto v : s) put(d, v);
 }
 
-double start_of(double t) { return t >= 631152000.0 ? static_cast<double>(static_cast<std::int64_t>(t * 1000.0)) / 1000.0 : 0.0; }
 
 
 /// The common part of CAN_FD_MESSAGE and CAN_FD_MESSAGE_64: flags, then `valid` data bytes
@@ -223,6 +222,10 @@ void parse_objects(std::string_view d, double start, const std::string& file, Lo
 
 }  // namespace
 
+double blf_start_of(double t0) noexcept {
+  return t0 >= 631152000.0 ? static_cast<double>(static_cast<std::int64_t>(t0 * 1000.0)) / 1000.0 : 0.0;
+}
+
 std::vector<LogEntry> parse_blf(std::string_view d, const std::string& file, LogReadReport* report) {
   if (d.size() < 72 || std::memcmp(d.data(), "LOGG", 4) != 0)
     throw InputError(file, 0, "LOGG", "not a BLF file (no LOGG header)");
@@ -282,11 +285,12 @@ std::vector<LogEntry> parse_blf(std::string_view d, const std::string& file, Log
 }
 
 void write_blf(std::ostream& os, const std::vector<LogEntry>& entries) {
+  check_writable_times(entries, LogFormat::blf, "");
   // The header's start time is the earliest frame's (logs may go backwards), so that no
   // object time is negative.
   double t0 = entries.empty() ? 0.0 : entries.front().frame.timestamp_s;
   for (const auto& e : entries) t0 = std::min(t0, e.frame.timestamp_s);
-  const double start = start_of(t0);
+  const double start = blf_start_of(t0);
   const double stop = entries.empty() ? 0.0 : entries.back().frame.timestamp_s;
   std::string objs;
   for (const auto& e : entries) {
@@ -334,6 +338,7 @@ void write_blf(std::ostream& os, const std::vector<LogEntry>& entries) {
       body.append(reinterpret_cast<const char*>(f.data.data()), 8);
     }
     const double rel = f.timestamp_s - start;
+    // In range: check_writable_times bounds rel to [0, writable_times(blf).max_offset_s).
     const auto ns = static_cast<std::uint64_t>(rel > 0 ? rel * 1e9 + 0.5 : 0.0);
     put_object_base(objs, 32, static_cast<std::uint32_t>(32 + body.size()), type);
     put<std::uint32_t>(objs, 2);  // TIME_ONE_NANS

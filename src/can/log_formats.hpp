@@ -37,6 +37,11 @@ inline std::uint32_t fd_dlc(std::uint32_t len) noexcept {
   return 15;
 }
 
+/// The BLF header's start time [s] for a log whose earliest frame is at `t0` [s]: t0 cut to
+/// the millisecond when it is a date (as python-can: from 1990-01-01 on), else 0 (times are
+/// offsets). Object times are written relative to it. `t0` within writable_times(blf).
+double blf_start_of(double t0) noexcept;
+
 /// Days since 1970-01-01 of a proleptic Gregorian date (Howard Hinnant's algorithm).
 std::int64_t days_from_civil(std::int64_t y, unsigned m, unsigned d);
 

@@ -204,6 +204,7 @@ std::vector<LogEntry> parse_trc(std::string_view text, const std::string& file, 
 }
 
 void write_trc(std::ostream& os, const std::vector<LogEntry>& entries) {
+  check_writable_times(entries, LogFormat::trc, "");
   // Offsets from the earliest frame (logs may go backwards), so that none is negative.
   double t0 = entries.empty() ? 0.0 : entries.front().frame.timestamp_s;
   for (const auto& e : entries) t0 = std::min(t0, e.frame.timestamp_s);

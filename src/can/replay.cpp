@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "lash/rt/periodic.hpp"
+#include "lash/io/numeric.hpp"
 
 namespace lash::can {
 
@@ -21,7 +22,8 @@ ReplayResult replay(Bus& bus, std::span<const LogEntry> entries, const ReplayOpt
   for (const auto& e : entries) {
     if (stop.load(std::memory_order_relaxed)) break;
     const double dt = (e.frame.timestamp_s - log0) / o.speed;
-    const std::int64_t deadline = t0 + static_cast<std::int64_t>(std::llround(dt * 1e9));
+    // Frames of a log span at most ~1e12 s (can::writable_times); a later one waits ~146 years.
+    const std::int64_t deadline = t0 + round_clamped<std::int64_t>(dt * 1e9, 0, std::int64_t{1} << 62);
     rt::sleep_until_ns(deadline - o.spin_ns, &stop);
     while (rt::monotonic_ns() < deadline && !stop.load(std::memory_order_relaxed)) {
     }

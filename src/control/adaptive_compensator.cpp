@@ -1,4 +1,5 @@
 #include "lash/control/adaptive_compensator.hpp"
+#include "lash/io/numeric.hpp"
 
 #include <cmath>
 #include <cstring>
@@ -11,7 +12,8 @@ void require(bool ok, const std::string& what) {
   if (!ok) throw std::invalid_argument(what);
 }
 std::uint64_t samples(double seconds, double dt_s) noexcept {
-  return static_cast<std::uint64_t>(std::llround(seconds / dt_s));
+  // Times are validated finite and >= 0; one beyond 2^64 samples is never reached.
+  return round_clamped<std::uint64_t>(seconds / dt_s, 0, std::numeric_limits<std::uint64_t>::max());
 }
 }  // namespace
 

@@ -4,9 +4,11 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "lash/control/ode3.hpp"
 #include "lash/signals/rng.hpp"
+#include "lash/io/numeric.hpp"
 
 namespace lash {
 
@@ -129,19 +131,32 @@ ClosedLoopTrace simulate_closed_loop(Solver solver, const PilotValveParams& plan
 }
 
 std::vector<double> StepTest::reference(double dt_s) const {
-  const auto n0 = static_cast<std::size_t>(std::llround(settle_s / dt_s));
-  const auto n1 = static_cast<std::size_t>(std::llround(after_s / dt_s));
+  const std::size_t n0 = steps_or_throw(settle_s, dt_s, "settle_s");
+  const std::size_t n1 = steps_or_throw(after_s, dt_s, "after_s");
   std::vector<double> r(n0 + n1, r1_kPa);
   for (std::size_t k = 0; k < n0; ++k) r[k] = r0_kPa;
   return r;
 }
 
-double StepTest::t_step_s(double dt_s) const { return static_cast<double>(std::llround(settle_s / dt_s)) * dt_s; }
+double StepTest::t_step_s(double dt_s) const { return static_cast<double>(steps_or_throw(settle_s, dt_s, "settle_s")) * dt_s; }
+
+namespace {
+constexpr double kMaxLevel_kPa = 1e5;
+}  // namespace
 
 StepResult run_step_test(Solver solver, const PilotValveParams& plant, const ControllerConfig& controller,
                          const StepTest& test, std::size_t bus_delay_steps) {
   if (!(test.settle_s > 0) || !(test.after_s > 0) || !(test.r0_kPa != test.r1_kPa))
     throw std::invalid_argument("step test needs settle_s > 0, after_s > 0 and r0 != r1");
+  // A level beyond ±1e5 kPa (100 MPa, above any hydraulic system) is a typo, and its square in
+  // the metrics overflows long before 1e300: refused, never a NaN result.
+  for (const auto& [name, r] : {std::pair{"r0_kPa (--r0)", test.r0_kPa}, std::pair{"r1_kPa (--r1)", test.r1_kPa}})
+    if (!(std::fabs(r) <= kMaxLevel_kPa))
+      throw std::invalid_argument(std::string(name) + " must be a finite level in [-1e5, 1e5] kPa");
+  const std::size_t n = steps_or_throw(test.settle_s, plant.dt_s, "settle_s") + steps_or_throw(test.after_s, plant.dt_s, "after_s");
+  if (bus_delay_steps > n)
+    throw std::invalid_argument("bus delay (--bus-delay) must be at most the test's " + std::to_string(n) +
+                                " samples, got " + std::to_string(bus_delay_steps));
   StepResult res;
   res.trace = simulate_closed_loop(solver, plant, controller, test.reference(plant.dt_s), bus_delay_steps);
   const double ts = test.t_step_s(plant.dt_s);

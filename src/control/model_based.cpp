@@ -7,6 +7,7 @@
 #include "lash/io/error.hpp"
 #include "lash/metrics/first_order.hpp"
 #include "lash/signals/rng.hpp"
+#include "lash/io/numeric.hpp"
 
 namespace lash {
 
@@ -62,8 +63,8 @@ FirstOrderDeadzoneModel identify_online_on_rig(const rigs::PilotValveRigParams& 
   ec.rls.lambda = 0.995;
   InputDeadzoneEstimator est(ec);
   Rng rng(seed ^ 0x5eedULL);
-  const auto n = static_cast<std::size_t>(std::llround(duration_s / dt_s));
-  const auto hold = static_cast<std::size_t>(std::llround(0.4 / dt_s));
+  const std::size_t n = steps_or_throw(duration_s, dt_s, "duration_s");
+  const std::size_t hold = std::max<std::size_t>(1, steps_or_throw(0.4, dt_s, "dt_s"));
   double y = rig.initial_output();
   double i = 0.0;
   for (std::size_t k = 0; k < n; ++k) {

@@ -12,6 +12,7 @@
 #include "lash/io/toml_util.hpp"
 #include "lash/rigs/coupled_carts.hpp"
 #include "lash/rigs/pilot_valve_rig.hpp"
+#include "lash/io/numeric.hpp"
 
 namespace lash::experiments {
 namespace {
@@ -170,6 +171,9 @@ ClosedLoopScenario load_closed_loop_scenario(const std::filesystem::path& path) 
   if (!(s.dt_s > 0)) t.fail("dt_s", "must be > 0 [s]");
   s.duration_s = t.number("duration_s");
   if (!(s.duration_s >= s.dt_s)) t.fail("duration_s", "must be at least one sample [s]");
+  // Step numbers (of the run and of its drifts, which lie inside it) are uint32 in the plant.
+  if (!round_to<std::uint32_t>(s.duration_s / s.dt_s))
+    t.fail("duration_s", "must be at most 4294967295 samples of dt_s = " + std::to_string(s.dt_s) + " s");
   if (auto seed = t.integer_opt("seed")) s.seed = static_cast<std::uint64_t>(*seed);
   {
     auto rp = t.table_opt("rig_params");

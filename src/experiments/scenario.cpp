@@ -9,6 +9,7 @@
 #include "lash/io/toml_util.hpp"
 #include "lash/plant/plant_file.hpp"
 #include "lash/plant/simulate.hpp"
+#include "lash/io/numeric.hpp"
 
 namespace lash {
 
@@ -41,8 +42,9 @@ ScenarioSpec load_scenario(const std::filesystem::path& path) {
   if (auto seeds = t.numbers_opt("seeds")) {
     s.seeds.clear();
     for (double x : *seeds) {
-      if (!(x >= 0 && x == std::floor(x))) t.fail("seeds", "seeds are non-negative integers");
-      s.seeds.push_back(static_cast<std::uint64_t>(x));
+      const auto seed = integral_as<std::uint64_t>(x);
+      if (!seed || x != std::floor(x)) t.fail("seeds", "seeds are integers in 0..2^64-1");
+      s.seeds.push_back(*seed);
     }
     if (s.seeds.empty()) t.fail("seeds", "at least one seed");
   }
@@ -123,7 +125,7 @@ ScenarioRun run_scenario(const ScenarioSpec& s, std::uint64_t seed) {
     ysim[k] = est.simulated();
     // checkpoint c is reached after the sample whose count is round(c/T)
     while (next < s.checkpoints_s.size() &&
-           k + 1 >= static_cast<std::size_t>(std::llround(s.checkpoints_s[next] / plant.dt_s()))) {
+           k + 1 >= round_clamped<std::size_t>(s.checkpoints_s[next] / plant.dt_s(), 0, std::numeric_limits<std::size_t>::max())) {
       run.at.push_back({est.params(Side::right), est.params(Side::left)});
       ++next;
     }

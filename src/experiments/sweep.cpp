@@ -14,6 +14,7 @@
 #include "lash/metrics/first_order.hpp"
 #include "lash/metrics/fit.hpp"
 #include "lash/plant/simulate.hpp"
+#include "lash/io/numeric.hpp"
 
 namespace lash::sweep {
 namespace {
@@ -39,7 +40,9 @@ SignalSpec signal_of(const Campaign& c, const RunSpec& r) {
   return s;
 }
 
-std::size_t index_at(double t_s, double dt_s) { return static_cast<std::size_t>(std::llround(t_s / dt_s)); }
+std::size_t index_at(double t_s, double dt_s) {
+  return round_clamped<std::size_t>(t_s / dt_s, 0, std::numeric_limits<std::size_t>::max());
+}
 
 /// Per side what the estimator identified, with its verdict (verdict.hpp): the sweep reports
 /// the estimator's decision and never re-decides it.

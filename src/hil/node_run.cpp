@@ -2,6 +2,7 @@
 
 #include <signal.h>
 #include <time.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -16,6 +17,7 @@
 #include "lash/io/csv.hpp"
 #include "lash/io/error.hpp"
 #include "lash/rt/dma_latency.hpp"
+#include "lash/io/numeric.hpp"
 #include "json_parts.hpp"
 
 namespace lash::hil {
@@ -208,7 +210,11 @@ MasterRun run_master_node(const BenchSettings& s, const MasterRunOptions& o, con
   const BenchLayout L = BenchLayout::from_dbc(s.dbc_file);
   MasterConfig mc = master_config(s, o.reference, o.dto_timeout_s);
   const std::size_t control_steps = steps_for(o.duration_s, s.step_s, "--duration");
-  const std::size_t steps = control_steps + static_cast<std::size_t>(std::ceil(mc.dto_timeout_s / s.step_s)) + 2;
+  const auto wait_steps = ceil_to<std::size_t>(mc.dto_timeout_s / s.step_s);
+  if (!wait_steps || *wait_steps > kMaxSteps)
+    throw option_error("--dto-timeout", "too long: " + format_double(mc.dto_timeout_s) + " s; at most " + std::to_string(kMaxSteps) +
+                                            " steps of " + format_double(s.step_s * 1e3) + " ms");
+  const std::size_t steps = control_steps + *wait_steps + 2;
   mc.log_capacity = steps;
   MasterNode master(L, mc);
   rt::PeriodicLoop loop(make_loop_config(o.loop, steps));
@@ -439,9 +445,18 @@ struct Writer {
 };
 
 struct Reader {
+  explicit Reader(int f) : fd(f) {
+    struct stat st {};
+    if (::fstat(fd, &st) == 0 && st.st_size >= 0) size = static_cast<std::uint64_t>(st.st_size);
+  }
   int fd;
   off_t at = 0;
   bool ok = true;
+  std::uint64_t size = 0;  ///< of the hand-over file: no count read from it may ask for more bytes than it holds
+  bool fits(std::uint64_t n, std::uint64_t elem) const noexcept {
+    const auto left = size - std::min<std::uint64_t>(size, static_cast<std::uint64_t>(at));
+    return elem == 0 || n <= left / elem;
+  }
   bool raw(void* p, std::size_t n) {
     auto* b = static_cast<char*>(p);
     while (ok && n > 0) {
@@ -463,17 +478,17 @@ struct Reader {
   template <class T>
   bool vec(std::vector<T>& v) {
     std::uint64_t n = 0;
-    if (!pod(n) || n > (std::uint64_t{1} << 32)) return ok = false;
+    if (!pod(n) || n > (std::uint64_t{1} << 32) || !fits(n, sizeof(T))) return ok = false;
     v.resize(n);
     return n == 0 || raw(v.data(), n * sizeof(T));
   }
   bool strings(std::vector<std::string>& v) {
     std::uint64_t n = 0;
-    if (!pod(n) || n > 4096) return ok = false;
+    if (!pod(n) || n > 4096 || !fits(n, sizeof(std::uint64_t))) return ok = false;
     v.resize(n);
     for (auto& s : v) {
       std::uint64_t len = 0;
-      if (!pod(len) || len > (1u << 20)) return ok = false;
+      if (!pod(len) || len > (1u << 20) || !fits(len, 1)) return ok = false;
       s.resize(len);
       if (len && !raw(s.data(), len)) return false;
     }
@@ -510,12 +525,12 @@ void write_run(int fd, const MasterRun& run) {
 }
 
 bool read_run(int fd, SlaveRun& run) {
-  Reader r{fd};
+  Reader r(fd);
   return read_common(r, run.stats, run.loop) && r.vec(run.log) && r.vec(run.events);
 }
 
 bool read_run(int fd, MasterRun& run) {
-  Reader r{fd};
+  Reader r(fd);
   return read_common(r, run.stats, run.loop) && r.vec(run.log) && r.vec(run.events) && r.vec(run.bus_log);
 }
 

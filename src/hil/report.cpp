@@ -1,4 +1,5 @@
 #include "lash/hil/report.hpp"
+#include "lash/io/numeric.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -21,7 +22,7 @@ std::optional<StepWindow> find_step(const std::vector<double>& r, double dt_s, d
       w.y0 = r[k - 1];
       w.y1 = r[k];
       std::size_t e = k + 1;
-      const auto max_n = static_cast<std::size_t>(std::llround(max_window_s / dt_s));
+      const auto max_n = round_clamped<std::size_t>(max_window_s / dt_s, 0, std::numeric_limits<std::size_t>::max());
       while (e < r.size() && r[e] == r[k] && e - k < max_n) ++e;
       w.end = e;
       return w;

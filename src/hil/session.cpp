@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/mman.h>
+#include <sys/file.h>
 #include <sys/prctl.h>
 #include <sys/select.h>
 #include <sys/wait.h>
@@ -21,6 +22,7 @@
 #include "lash/io/csv.hpp"
 #include "lash/io/error.hpp"
 #include "lash/rt/periodic.hpp"
+#include "lash/io/numeric.hpp"
 
 namespace lash::hil {
 
@@ -102,7 +104,7 @@ bool reap(Child& c, std::int64_t t0) {
 
 /// Waits for the child to exit, SIGKILL after timeout_s.
 void reap_blocking(Child& c, std::int64_t t0, double timeout_s) {
-  const std::int64_t end = rt::monotonic_ns() + static_cast<std::int64_t>(timeout_s * 1e9);
+  const std::int64_t end = rt::monotonic_ns() + round_clamped<std::int64_t>(timeout_s * 1e9, 0, std::int64_t{1} << 62);
   while (!reap(c, t0)) {
     if (rt::monotonic_ns() > end) {
       kill(c.pid, SIGKILL);
@@ -120,7 +122,7 @@ void reap_blocking(Child& c, std::int64_t t0, double timeout_s) {
 /// signal arrives, or timeout_s passes (false).
 bool wait_ready(const Child& c, double timeout_s) {
   std::string got;
-  const std::int64_t end = rt::monotonic_ns() + static_cast<std::int64_t>(timeout_s * 1e9);
+  const std::int64_t end = rt::monotonic_ns() + round_clamped<std::int64_t>(timeout_s * 1e9, 0, std::int64_t{1} << 62);
   char buf[256];
   while (rt::monotonic_ns() < end && g_stop_signal.load() == 0) {
     fd_set set;
@@ -194,6 +196,38 @@ void SessionOptions::validate() const {
     throw InputError(out_dir.string(), 0, "--out-dir", std::string("not writable (") + std::strerror(errno) + ")");
 }
 
+namespace {
+/// One run per output directory: an flock on `<dir>/.lash-run.lock` (holding the owner's pid),
+/// released by the kernel when the run ends or dies, so a lock is never stale.
+class OutDirLock {
+ public:
+  explicit OutDirLock(const std::filesystem::path& dir) {
+    const auto path = dir / ".lash-run.lock";
+    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
+    if (fd_ < 0)
+      throw InputError(dir.string(), 0, "--out-dir", std::string("cannot create its lock file (") + std::strerror(errno) + ")");
+    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      char buf[32] = {};
+      const ssize_t n = ::pread(fd_, buf, sizeof buf - 1, 0);
+      ::close(fd_);
+      throw InputError(dir.string(), 0, "--out-dir",
+                       "in use by another lash hil run (pid " + std::string(buf, n > 0 ? static_cast<std::size_t>(n) : 0) +
+                           "): its files would be replaced; give another --out-dir");
+    }
+    const std::string pid = std::to_string(::getpid());
+    if (::ftruncate(fd_, 0) != 0 || ::pwrite(fd_, pid.data(), pid.size(), 0) < 0) {
+      // the lock is what matters; the pid is only for the message of a second run
+    }
+  }
+  OutDirLock(const OutDirLock&) = delete;
+  OutDirLock& operator=(const OutDirLock&) = delete;
+  ~OutDirLock() { ::close(fd_); }
+
+ private:
+  int fd_ = -1;
+};
+}  // namespace
+
 Session::Session(SessionOptions options) : o_(std::move(options)) {}
 
 RunReport Session::run(const std::function<void(const std::string&)>& progress) {
@@ -206,6 +240,7 @@ RunReport Session::run(const std::function<void(const std::string&)>& progress) 
   const MasterConfig mc = master_config(o_.settings, o_.reference);
   const SlaveConfig sc = slave_config(o_.settings, L);
   const std::filesystem::path dir = o_.out_dir;
+  const OutDirLock lock(dir);  // held until the run's files are written
   for (const auto& f : session_files()) {
     std::error_code ec;
     std::filesystem::remove(dir / f, ec);

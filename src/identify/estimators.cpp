@@ -1,4 +1,5 @@
 #include "lash/identify/estimators.hpp"
+#include "lash/io/numeric.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -32,7 +33,8 @@ bool conditioned(const EstimatorConfig& c, const Rls<N>& r) noexcept {
   return c.method == EstimationMethod::iv || verdict_rules::well_conditioned<N>(r.P());
 }
 std::uint64_t fit_start_index(const EstimatorConfig& c) {
-  return static_cast<std::uint64_t>(std::ceil(c.fit_start_s / c.dt_s - 1e-9));
+  // A start beyond 2^64 samples is never reached.
+  return ceil_to<std::uint64_t>(c.fit_start_s / c.dt_s - 1e-9).value_or(std::numeric_limits<std::uint64_t>::max());
 }
 }  // namespace
 
@@ -475,7 +477,7 @@ CoupledCartsEstimator::CoupledCartsEstimator(const EstimatorConfig& cfg)
       pre_(cfg.noise, cfg.dt_s),
       rls_{Rls<3>(cfg.rls3()), Rls<3>(cfg.rls3())},
       warmup_(detail::warmup_samples(cfg, pre_)) {
-  stage2_k_ = static_cast<std::uint64_t>(std::ceil(cfg.stage2_start_s / cfg.dt_s - 1e-9));
+  stage2_k_ = ceil_to<std::uint64_t>(cfg.stage2_start_s / cfg.dt_s - 1e-9).value_or(std::numeric_limits<std::uint64_t>::max());
   fit_.k0 = fit_start_index(cfg);
 }
 

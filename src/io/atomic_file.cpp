@@ -1,11 +1,20 @@
 #include "lash/io/atomic_file.hpp"
 
+#include <fcntl.h>
+#include <sys/random.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
+#include <cstdint>
+#include <ctime>
+#include <ext/stdio_filebuf.h>
 #include <cstring>
 #include <iostream>
 #include <system_error>
+
+#include <fmt/core.h>
 
 #include "lash/io/error.hpp"
 
@@ -44,6 +53,32 @@ std::string open_failure_reason(const std::filesystem::path& target, const std::
   return "cannot open for writing: " + why;
 }
 
+std::uint64_t random_u64() {
+  std::uint64_t r = 0;
+  if (::getrandom(&r, sizeof r, 0) == static_cast<ssize_t>(sizeof r)) return r;
+  // No entropy source: still unique per call (O_EXCL refuses a taken name anyway).
+  static std::atomic<std::uint64_t> n{0};
+  return (static_cast<std::uint64_t>(::getpid()) << 32) ^ static_cast<std::uint64_t>(::time(nullptr)) ^
+         (n.fetch_add(1) * 0x9E3779B97F4A7C15ull);
+}
+
+/// Creates the temporary next to `target` at an unpredictable name; -1 with errno set if it cannot.
+int create_temp(const std::filesystem::path& target, std::filesystem::path& tmp) {
+  struct stat st {};
+  const bool keep_mode = ::stat(target.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+  for (int attempt = 0; attempt < 64; ++attempt) {
+    tmp = target;
+    tmp += fmt::format(".tmp.{:016x}", random_u64());
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+    if (fd >= 0) {
+      if (keep_mode) (void)::fchmod(fd, st.st_mode & 07777);
+      return fd;
+    }
+    if (errno != EEXIST) return -1;
+  }
+  return -1;
+}
+
 }  // namespace
 
 AtomicFile::AtomicFile(std::filesystem::path target) : target_(std::move(target)) {
@@ -53,23 +88,28 @@ AtomicFile::AtomicFile(std::filesystem::path target) : target_(std::move(target)
     os_ = &std::cout;
     return;
   }
-  if (is_stream_output(target_)) {
+  errno = 0;
+  int fd = -1;
+  if (is_stream_output(target_)) {  // an existing device, FIFO or socket: written in place
     direct_ = true;
     tmp_ = target_;
-    errno = 0;
-    out_.open(tmp_, std::ios::out | std::ios::binary);
+    fd = ::open(tmp_.c_str(), O_WRONLY | O_CLOEXEC);
   } else {
-    tmp_ = target_;
-    tmp_ += ".tmp." + std::to_string(::getpid());
-    errno = 0;
-    out_.open(tmp_, std::ios::out | std::ios::trunc | std::ios::binary);
+    fd = create_temp(target_, tmp_);
   }
-  if (!out_) throw InputError(target_.string(), 0, "", open_failure_reason(target_, tmp_));
+  if (fd < 0) throw InputError(target_.string(), 0, "", open_failure_reason(target_, tmp_));
+  buf_ = std::make_unique<__gnu_cxx::stdio_filebuf<char>>(fd, std::ios::out | std::ios::binary, std::size_t{1} << 16);
+  out_.rdbuf(buf_.get());
+}
+
+bool AtomicFile::close_file() noexcept {
+  auto* fb = static_cast<__gnu_cxx::stdio_filebuf<char>*>(buf_.get());
+  return fb == nullptr || !fb->is_open() || fb->close() != nullptr;
 }
 
 AtomicFile::~AtomicFile() {
   if (!committed_ && !direct_) {
-    out_.close();
+    (void)close_file();
     std::error_code ec;
     std::filesystem::remove(tmp_, ec);
   }
@@ -77,8 +117,8 @@ AtomicFile::~AtomicFile() {
 
 void AtomicFile::commit() {
   os_->flush();
-  const bool ok = static_cast<bool>(*os_);
-  if (os_ == &out_) out_.close();
+  bool ok = static_cast<bool>(*os_);
+  if (os_ == &out_) ok = close_file() && ok;
   if (!ok) throw InputError(target_.string(), 0, "", "write failed");
   if (!direct_) {
     std::error_code ec;

@@ -4,6 +4,19 @@
 
 namespace lash {
 namespace {
+/// At most `max` bytes of `s` (cut before a UTF-8 continuation byte), then "… (N bytes)": an
+/// error never echoes a whole 300 MB header line or a million column names.
+std::string bounded(std::string s, std::size_t max) {
+  if (s.size() <= max) return s;
+  const std::size_t n = s.size();
+  std::size_t cut = max;
+  while (cut > 0 && (static_cast<unsigned char>(s[cut]) & 0xC0) == 0x80) --cut;
+  s.resize(cut);
+  return s + fmt::format("\u2026 ({} bytes)", n);
+}
+constexpr std::size_t kMaxField = 200;     // a name or a value quoted from the input
+constexpr std::size_t kMaxMessage = 1000;  // what was wrong (it may quote the input too)
+
 std::string compose(const std::string& file, int line, const std::string& field, const std::string& message) {
   std::string where;
   if (!file.empty()) where = line > 0 ? fmt::format("{}:{}: ", file, line) : fmt::format("{}: ", file);
@@ -13,10 +26,10 @@ std::string compose(const std::string& file, int line, const std::string& field,
 }  // namespace
 
 InputError::InputError(std::string file, int line, std::string field, const std::string& message)
-    : Error(compose(file, line, field, message)),
+    : Error(compose(file, line, bounded(field, kMaxField), bounded(message, kMaxMessage))),
       file_(std::move(file)),
       line_(line),
-      field_(std::move(field)),
-      message_(message) {}
+      field_(bounded(std::move(field), kMaxField)),
+      message_(bounded(message, kMaxMessage)) {}
 
 }  // namespace lash

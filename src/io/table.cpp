@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <limits>
@@ -15,12 +16,22 @@
 
 namespace lash {
 
+namespace {
+/// The header's names for an error: "a,b,c", or the first ~200 characters and how many columns.
+std::string header_list(const std::vector<std::string>& names) {
+  std::string have;
+  for (const auto& h : names) {
+    if (have.size() + h.size() > 200) return have + ",\u2026 (" + std::to_string(names.size()) + " columns)";
+    have += (have.empty() ? "" : ",") + h;
+  }
+  return have;
+}
+}  // namespace
+
 std::size_t Table::column(std::string_view name) const {
   for (std::size_t i = 0; i < names.size(); ++i)
     if (names[i] == name) return i;
-  std::string have;
-  for (const auto& h : names) have += (have.empty() ? "" : ",") + h;
-  throw InputError(file, 1, std::string(name), "no such column (the header has: " + have + ")");
+  throw InputError(file, 1, std::string(name), "no such column (the header has: " + header_list(names) + ")");
 }
 
 namespace {
@@ -117,9 +128,7 @@ std::vector<std::size_t> choose(const std::string& file, int header_line, const 
                          "column index out of range (the file has " + std::to_string(header.size()) +
                              " columns, 0.." + std::to_string(header.size() - 1) + ")");
     } else {
-      std::string have;
-      for (const auto& h : header) have += (have.empty() ? "" : ",") + h;
-      throw InputError(file, header_line, w, "no such column (the header has: " + have + ")");
+      throw InputError(file, header_line, w, "no such column (the header has: " + header_list(header) + ")");
     }
     if (std::find(idx.begin(), idx.end(), i) != idx.end())
       throw InputError(file, 0, "--columns", "column '" + header[i] + "' (index " + std::to_string(i) +
@@ -128,6 +137,9 @@ std::vector<std::size_t> choose(const std::string& file, int header_line, const 
   }
   return idx;
 }
+
+/// The longest line the text reader takes (a header of 10^6 columns is ~10 MiB).
+constexpr std::size_t kMaxLineBytes = std::size_t{64} << 20;
 
 /// The text reader. State across blocks: the header, the chosen fields, the columns.
 class TextReader {
@@ -143,9 +155,20 @@ class TextReader {
     std::vector<char> buf(1 << 20);
     std::size_t have = 0;
     bool first_block = true;
+    std::uint64_t offset = 0;  // of buf[0] in the file
     for (;;) {
-      if (have == buf.size()) buf.resize(buf.size() * 2);  // a line longer than the buffer
+      if (have == buf.size()) {  // a line longer than the buffer
+        if (buf.size() >= kMaxLineBytes)
+          throw InputError(t_.file, lineno_ + 1, "",
+                           "line longer than " + std::to_string(kMaxLineBytes >> 20) + " MiB: not a text table");
+        buf.resize(buf.size() * 2);
+      }
       const std::size_t got = std::fread(buf.data() + have, 1, buf.size() - have, f.get());
+      if (const void* z = std::memchr(buf.data() + have, '\0', got))
+        throw InputError(t_.file, 0, "",
+                         "binary data (a NUL byte at offset " +
+                             std::to_string(offset + static_cast<std::uint64_t>(static_cast<const char*>(z) - buf.data())) +
+                             "): not a text table (CSV, TSV, ...) nor a MAT file");
       const bool eof = got < buf.size() - have;
       have += got;
       const char* p = buf.data();
@@ -166,6 +189,7 @@ class TextReader {
         if (p < end) line(p, end);
         break;
       }
+      offset += static_cast<std::uint64_t>(p - buf.data());
       have = static_cast<std::size_t>(end - p);
       std::memmove(buf.data(), p, have);
     }

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <fmt/core.h>
+
 #include "lash/signals/rng.hpp"
 
 namespace lash {
@@ -50,6 +52,12 @@ SimulationTrace simulate(Plant& plant, std::span<const double> v, double noise_v
   tr.cols.assign(tr.names.size(), std::vector<double>(n));
   for (std::size_t k = 0; k < n; ++k) {
     const double y = plant.step(v[k]);
+    // A finite input must give a finite output: an overflow (an amplitude of 1e308 through a
+    // gain) is refused, never written as inf (a non-finite input passes through as given).
+    if (!std::isfinite(y) && std::isfinite(v[k])) [[unlikely]]
+      throw std::invalid_argument(fmt::format("the plant's output overflows at sample {} (t = {} s) for the input {}: "
+                                              "reduce the input's amplitude or the plant's gains",
+                                              k, static_cast<double>(k) * dt, v[k]));
     tr.cols[0][k] = static_cast<double>(k) * dt;
     tr.cols[1][k] = v[k];
     tr.cols[2][k] = y + noise.step();

@@ -16,8 +16,9 @@ void PilotValveParams::validate() const {
   require(std::isfinite(gain_kPa_per_mA) && gain_kPa_per_mA > 0, "pilot valve gain_kPa_per_mA must be > 0");
   require(std::isfinite(tau_s) && tau_s > 0, "pilot valve tau_s must be > 0");
   require(std::isfinite(tau2_s) && tau2_s >= 0, "pilot valve tau2_s must be >= 0 (0 = no second lag)");
-  require(std::isfinite(bias_kPa), "pilot valve bias_kPa must be finite");
-  require(std::isfinite(noise_sigma_kPa) && noise_sigma_kPa >= 0, "pilot valve noise_sigma_kPa must be >= 0");
+  // Beyond ±1e5 kPa (100 MPa) a pressure is no hydraulic pilot stage's, and the metrics' squares overflow.
+  require(std::fabs(bias_kPa) <= 1e5, "pilot valve bias_kPa must be in [-1e5, 1e5] kPa");
+  require(noise_sigma_kPa >= 0 && noise_sigma_kPa <= 1e5, "pilot valve noise_sigma_kPa (--noise-sigma) must be in [0, 1e5] kPa");
   require(std::isfinite(dt_s) && dt_s > 0, "pilot valve dt_s must be > 0");
 }
 

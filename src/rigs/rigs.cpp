@@ -5,6 +5,7 @@
 #include "lash/rigs/coupled_carts.hpp"
 #include "lash/rigs/motor_cart.hpp"
 #include "lash/rigs/pilot_valve_rig.hpp"
+#include "lash/io/numeric.hpp"
 
 namespace lash::rigs {
 namespace {
@@ -127,7 +128,7 @@ PilotValveRig::PilotValveRig(const PilotValveRigParams& p, double dt_s, std::uin
   h_ = dt_s / p_.substeps;
   sol_alpha_ = -std::expm1(-h_ / p_.solenoid_tau_s);
   // Bias record at zero current (paper 2 §2.7.1): mean of the readings over bias_window_s.
-  const long n = std::lround(p_.bias_window_s / dt_s);
+  const auto n = static_cast<long>(steps_or_throw(p_.bias_window_s, dt_s, "bias_window_s", std::size_t{100'000'000}));
   if (n > 0) {
     double sum = 0.0;
     for (long k = 0; k < n; ++k) sum += measure();

@@ -247,3 +247,44 @@ TEST(CanDbc, ExtendedMultiplexingDecodesAndEncodes) {
   // written back and read again: the same database
   EXPECT_EQ(parse_dbc(write_dbc(db), "w.dbc"), db);
 }
+
+// CANdb++ writes names over 32 characters short and keeps the long one in an attribute; the
+// long one is the name everywhere (the DBC text below is the layout of cantools' issue_784.dbc).
+TEST(CanDbc, NodeAndEnvVarLongNamesReplaceTheShortOnes) {
+  const std::string text = R"(VERSION ""
+BS_:
+BU_: ECU2_123456789012345678901234567 ECU1
+BO_ 256 M: 8 ECU2_123456789012345678901234567
+ SG_ S : 0|8@1+ (1,0) [0|255] "" ECU1,ECU2_123456789012345678901234567
+EV_ EnvVar_12345678901234567890123456: 0 [0|1] "" 0 1 DUMMY_NODE_VECTOR0 Vector__XXX;
+CM_ BU_ ECU2_123456789012345678901234567 "Second ECU";
+BA_DEF_ BU_  "SystemNodeLongSymbol" STRING ;
+BA_DEF_ EV_  "SystemEnvVarLongSymbol" STRING ;
+BA_DEF_ BU_  "NodeLayerModules" STRING ;
+BA_ "SystemNodeLongSymbol" BU_ ECU2_123456789012345678901234567 "ECU2_12345678901234567890123456789012";
+BA_ "NodeLayerModules" BU_ ECU2_123456789012345678901234567 "CANoeILNLVector.dll";
+BA_ "SystemEnvVarLongSymbol" EV_ EnvVar_12345678901234567890123456 "EnvVar_1234567890123456789012345678901234";
+)";
+  const Database db = parse_dbc(text);
+  const std::string longer = "ECU2_12345678901234567890123456789012";
+  ASSERT_EQ(db.nodes.size(), 2u);
+  EXPECT_EQ(db.nodes[0], longer);
+  ASSERT_EQ(db.messages.size(), 1u);
+  EXPECT_EQ(db.messages[0].transmitter, longer);
+  EXPECT_EQ(db.messages[0].signals[0].receivers, (std::vector<std::string>{"ECU1", longer}));
+  ASSERT_EQ(db.node_comments.size(), 1u);
+  EXPECT_EQ(db.node_comments[0].node, longer);
+  int module_attrs = 0;
+  for (const auto& a : db.attributes)
+    if (a.name == "NodeLayerModules") {
+      EXPECT_EQ(a.node, longer);
+      ++module_attrs;
+    }
+  EXPECT_EQ(module_attrs, 1);
+  bool env = false;
+  for (const auto& s : db.other_statements)
+    env = env || s.rfind("EV_ EnvVar_1234567890123456789012345678901234:", 0) == 0;
+  EXPECT_TRUE(env);
+  // written and read back: the same database (the long names are a fixed point)
+  EXPECT_EQ(parse_dbc(write_dbc(db)), db);
+}

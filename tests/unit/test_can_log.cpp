@@ -1,7 +1,9 @@
 // candump -L lines and cansend frame text.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
+#include <limits>
 
 #include "lash/can/log.hpp"
 #include "lash/io/error.hpp"
@@ -128,4 +130,61 @@ TEST(CanLog, FileErrorsNameTheLine) {
   EXPECT_TRUE(same_content(back[1].frame, v[1].frame));
   EXPECT_EQ(back[1].frame.timestamp_s, 2.5);
   std::filesystem::remove(tmp);
+}
+
+namespace {
+std::vector<LogEntry> frames_at(std::initializer_list<double> times) {
+  std::vector<LogEntry> v;
+  for (double t : times) {
+    std::string err;
+    LogEntry e{*parse_frame_text("123#01", err), "1"};
+    e.frame.timestamp_s = t;
+    v.push_back(e);
+  }
+  return v;
+}
+/// write_log's InputError for `times` in `ext`, "" when it writes; the file must not exist after a refusal.
+std::string refusal(const std::string& ext, std::initializer_list<double> times) {
+  const auto p = std::filesystem::temp_directory_path() / ("lash_test_times" + ext);
+  std::filesystem::remove(p);
+  try {
+    write_log(p, frames_at(times));
+  } catch (const lash::InputError& e) {
+    EXPECT_FALSE(std::filesystem::exists(p)) << "half-written " << p;
+    return e.field() + ": " + e.message();
+  }
+  std::filesystem::remove(p);
+  return "";
+}
+}  // namespace
+
+// Limits from the formats' fields: BLF object times are uint64 nanoseconds from the header's
+// start, 2^64 ns = 18446744073.709551616 s; the header's SYSTEMTIME year is a uint16 (year 65536
+// begins at 2005949145600 s = day 23217004 after 1970-01-01, days_from_civil evaluated in Python,
+// which gives 946684800 s for 2000-01-01); candump's reader takes 12 digits of seconds.
+TEST(CanLog, WritersRefuseTimesTheirFormatCannotHold) {
+  // the BLF finding of the fuzzer: two frames 1.8446744e10 s apart (just below 2^64 ns + 0.5 rounding)
+  EXPECT_EQ(refusal(".blf", {0.0, 18446744073.709551}).rfind("frame 2: timestamp", 0), 0u);
+  EXPECT_EQ(refusal(".blf", {0.0, 18446744072.0}), "");
+  EXPECT_NE(refusal(".blf", {-1.0, 5.0}).find("frame 1"), std::string::npos);  // before 1990: offsets from 0
+  EXPECT_EQ(refusal(".blf", {2005949145599.0}), "");
+  EXPECT_NE(refusal(".blf", {2005949145600.0}), "");
+  EXPECT_NE(refusal(".blf", {1.0, std::nan("")}).find("frame 2"), std::string::npos);
+  EXPECT_NE(refusal(".log", {1.0, -0.5}).find("frame 2"), std::string::npos);
+  EXPECT_NE(refusal(".log", {1e12}), "");
+  EXPECT_EQ(refusal(".log", {999999999999.0}), "");
+  EXPECT_NE(refusal(".asc", {1.0, std::numeric_limits<double>::infinity()}).find("frame 2"), std::string::npos);
+  EXPECT_NE(refusal(".trc", {-1e308, 1e308}).find("frame 2"), std::string::npos);  // the offset overflows
+  EXPECT_EQ(refusal(".asc", {-5.0, 1e9}), "");
+  EXPECT_EQ(refusal(".trc", {-5.0, 1e9}), "");
+}
+
+TEST(CanLog, BlfKeepsTimesAtTheEdgeOfItsRange) {
+  const auto p = std::filesystem::temp_directory_path() / "lash_test_edge.blf";
+  const auto v = frames_at({1.0, 18446744000.0});
+  write_log(p, v);
+  const auto back = read_log(p);
+  ASSERT_EQ(back.size(), 2u);
+  EXPECT_DOUBLE_EQ(back[1].frame.timestamp_s, 18446744000.0);
+  std::filesystem::remove(p);
 }

@@ -10,6 +10,7 @@
 #include "lash/io/atomic_file.hpp"
 #include "lash/io/csv.hpp"
 #include "lash/io/error.hpp"
+#include "lash/io/numeric.hpp"
 #include "lash/io/table.hpp"
 #include "lash/plant/plant_file.hpp"
 
@@ -290,5 +291,38 @@ TEST(Table, MedianStepOfLongRecordsIsTheSortedMiddle) {
       EXPECT_EQ(s.max_jitter, jitter) << "n " << n << " kind " << kind;
       EXPECT_EQ(s.gap_rows.size(), gaps) << "n " << n << " kind " << kind;
     }
+  }
+}
+
+// Range limits by hand: int8 holds -128..127, uint64 below 2^64 = 18446744073709551616, and
+// a double next to 2^63 (2^63 - 1024 is the largest double below it).
+TEST(Numeric, ConversionsAreRangeCheckedFirst) {
+  EXPECT_EQ(lash::round_to<std::int8_t>(127.4), std::int8_t{127});
+  EXPECT_FALSE(lash::round_to<std::int8_t>(127.5));  // rounds half away from zero, to 128
+  EXPECT_EQ(lash::round_to<std::int8_t>(-128.49), std::int8_t{-128});
+  EXPECT_FALSE(lash::round_to<std::int8_t>(-128.5));
+  EXPECT_FALSE(lash::round_to<std::uint32_t>(-0.6));
+  EXPECT_EQ(lash::round_to<std::uint32_t>(-0.4), 0u);
+  EXPECT_FALSE(lash::round_to<int>(std::nan("")));
+  EXPECT_FALSE(lash::round_to<long>(std::numeric_limits<double>::infinity()));
+  EXPECT_FALSE(lash::round_to<std::uint64_t>(18446744073709551616.0));
+  EXPECT_EQ(lash::round_to<std::uint64_t>(18446744073709549568.0), 18446744073709549568ull);  // 2^64 - 2048
+  EXPECT_FALSE(lash::round_to<std::int64_t>(9223372036854775808.0));                         // 2^63
+  EXPECT_EQ(lash::round_to<std::int64_t>(9223372036854774784.0), 9223372036854774784ll);     // 2^63 - 1024
+  EXPECT_EQ(lash::ceil_to<std::size_t>(2.000001), 3u);
+  EXPECT_EQ(lash::floor_to<int>(-2.5), -3);
+  EXPECT_EQ(lash::round_clamped<std::int64_t>(1e300, 0, 100), 100);
+  EXPECT_EQ(lash::round_clamped<std::int64_t>(std::nan(""), 0, 100), 0);
+  EXPECT_EQ(lash::round_clamped<std::int64_t>(-7.0, 0, 100), 0);
+  EXPECT_EQ(lash::round_clamped<std::int64_t>(41.5, 0, 100), 42);
+  EXPECT_EQ(lash::steps_or_throw(1.0, 0.005, "--duration"), 200u);
+  EXPECT_THROW(lash::steps_or_throw(1e300, 0.005, "--duration"), std::invalid_argument);
+  EXPECT_THROW(lash::steps_or_throw(-1.0, 0.005, "--duration"), std::invalid_argument);
+  EXPECT_THROW(lash::steps_or_throw(1.0, 0.0, "--duration"), std::invalid_argument);  // inf steps
+  try {
+    lash::steps_or_throw(std::nan(""), 0.005, "settle_s");
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("settle_s: ", 0), 0u) << e.what();
   }
 }

@@ -30,7 +30,8 @@ struct LogEntry {
 
 /// Parses one `candump -L` line. nullopt + `error` on bad text. Never throws.
 std::optional<LogEntry> parse_log_line(std::string_view line, std::string& error) noexcept;
-/// `(1600000000.123456) vcan0 123#DEADBEEF` (no newline); time rounded to 1 µs.
+/// `(1600000000.123456) vcan0 123#DEADBEEF` (no newline); time rounded to 1 µs, written as 0
+/// when candump cannot hold it (writable_times).
 std::string format_log_line(const Frame& frame, std::string_view interface);
 
 /// Log file formats, chosen by extension: .asc (Vector ASCII), .blf (Vector binary
@@ -53,6 +54,21 @@ std::vector<LogEntry> read_log(const std::filesystem::path& path, LogReadReport*
 /// Parses candump text (same rules as read_log; `file` names the source in errors).
 std::vector<LogEntry> parse_log(std::string_view text, const std::string& file = "<log>", LogReadReport* report = nullptr);
 /// Writes entries atomically (lash::AtomicFile) in the format of the extension.
+/// Throws lash::InputError (nothing written) when a frame's time cannot be written in that
+/// format (see writable_times).
 void write_log(const std::filesystem::path& path, const std::vector<LogEntry>& entries);
+
+/// The times [s] a format can write. Absolute formats (candump) bound each time; relative
+/// formats (ASC, TRC, BLF) bound each time's offset from the earliest frame, and BLF its
+/// header date (the earliest time) as well. Every time must be finite.
+struct TimeSpan {
+  double min_abs_s;     ///< smallest time (absolute formats and BLF's start)
+  double max_abs_s;     ///< largest time / BLF header date (exclusive)
+  double max_offset_s;  ///< largest offset from the earliest frame (exclusive)
+};
+TimeSpan writable_times(LogFormat format) noexcept;
+/// Throws lash::InputError (file `file`, field "frame N" 1-based, the time) at the first
+/// frame whose time `format` cannot represent; writers call it before writing a byte.
+void check_writable_times(const std::vector<LogEntry>& entries, LogFormat format, const std::string& file);
 
 }  // namespace lash::can

@@ -6,20 +6,26 @@
 /// destroyed without commit (an error was thrown), the temporary is removed
 /// and nothing half-written is left behind.
 ///
+/// The temporary is `<target>.tmp.<16 random hex digits>` (getrandom), created
+/// with O_CREAT|O_EXCL|O_NOFOLLOW: a link, file or FIFO planted at any name is
+/// never followed, opened or truncated (a taken name is skipped). It gets the
+/// target's mode when the target exists (else 0666 less the umask).
+///
 /// A target that exists and is not a regular file (`/dev/null`, a FIFO, a
 /// terminal) is opened and written directly — never renamed over — and the
 /// name `-` means standard output. Those outputs are streams, so "whole or
 /// nothing" cannot hold for them. Not real-time safe.
 #include <filesystem>
 #include <string>
-#include <fstream>
+#include <memory>
 #include <ostream>
+#include <streambuf>
 
 namespace lash {
 
 class AtomicFile {
  public:
-  /// Opens the temporary `<target>.tmp.<pid>` (regular file), the target
+  /// Opens the temporary `<target>.tmp.<random>` (regular file), the target
   /// itself (existing non-regular file) or stdout (`-`); throws InputError
   /// naming the target and the system's reason if it cannot.
   explicit AtomicFile(std::filesystem::path target);
@@ -38,9 +44,12 @@ class AtomicFile {
   void commit();
 
  private:
+  bool close_file() noexcept;
+
   std::filesystem::path target_;
   std::filesystem::path tmp_;
-  std::ofstream out_;
+  std::unique_ptr<std::streambuf> buf_;  ///< over the file's descriptor (it closes it)
+  std::ostream out_{nullptr};
   std::ostream* os_ = &out_;
   bool direct_ = false;
   bool committed_ = false;
