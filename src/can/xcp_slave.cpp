@@ -233,7 +233,7 @@ bool Slave::on_frame(const Frame& f) {
     return true;
   }
   const std::uint8_t code = f.data[0];
-  if (!connected_ && code != cmd::connect) return true;  // Part 2 §1.3: DISCONNECTED answers CONNECT only
+  if (!connected_ && code != cmd::connect) return true;  // DISCONNECTED answers CONNECT only (Part 2, state machine)
   // A block transfer is interrupted by any command but its DOWNLOAD_NEXT.
   if (code != cmd::download_next) block_left_ = 0;
   command(f);
@@ -338,7 +338,7 @@ void Slave::command(const Frame& f) {
     case cmd::download_next: {
       if (!need(2)) return;
       if (block_left_ == 0) return error(Err::sequence);
-      if (d[1] != block_left_) {  // Part 2 §1.6.2.3: ERR_SEQUENCE with the number of elements expected
+      if (d[1] != block_left_) {  // DOWNLOAD_NEXT: ERR_SEQUENCE + the number of elements expected
         const std::uint8_t expected[] = {static_cast<std::uint8_t>(block_left_)};
         block_left_ = 0;
         return error(Err::sequence, expected);

@@ -213,10 +213,9 @@ MasterRun run_master_node(const BenchSettings& s, const MasterRunOptions& o, con
   mc.log_capacity = steps;
   MasterNode master(L, mc);
   rt::PeriodicLoop loop(make_loop_config(o.loop, steps));
-  MasterRun out;
-  out.loop.warnings = loop.apply_realtime_settings();
-  auto bus = open_node_bus(s.bus, L, true);
   // The XCP slave: its own thread and socket; the step meets it through two lock-free queues.
+  // Started before the loop's real-time settings, so that it keeps the default scheduler and
+  // every CPU (a thread inherits SCHED_FIFO and the affinity of the thread that creates it).
   std::unique_ptr<XcpLink> link;
   std::unique_ptr<XcpServer> xcp;
   if (o.xcp) {
@@ -224,6 +223,9 @@ MasterRun run_master_node(const BenchSettings& s, const MasterRunOptions& o, con
     xcp = std::make_unique<XcpServer>(s.bus, L, *link, initial_calibration(mc));
     master.attach(link.get());
   }
+  MasterRun out;
+  out.loop.warnings = loop.apply_realtime_settings();
+  auto bus = open_node_bus(s.bus, L, true);
   const auto N = static_cast<std::int64_t>(control_steps);
   can::ControllerBus ctl(*bus, node_controller_config(loop.config().period_ns));
   {

@@ -115,7 +115,10 @@ void XcpServer::drain_samples() {
 
 void XcpServer::run() {
   while (!stop_.load()) {
-    if (auto f = bus_->receive(std::chrono::milliseconds(1))) slave_->on_frame(*f);
+    // Wake every 1 ms while DAQ runs (samples go out within a millisecond of their step), else
+    // only for commands or every 20 ms: an idle slave costs the host (and the step) nearly nothing.
+    const auto wait = slave_->daq_running() ? std::chrono::milliseconds(1) : std::chrono::milliseconds(20);
+    if (auto f = bus_->receive(wait)) slave_->on_frame(*f);
     drain_samples();
     if (has_pending_ && link_.pages.push(pending_)) {
       has_pending_ = false;

@@ -1,6 +1,6 @@
 // The XCP slave engine at the byte level: every request and every expected reply below is
 // written by hand from the tables of ASAM MCD-1 XCP V1.1 Part 2 (command/response layouts,
-// §1.6) and Part 3 CAN (classic frames, MAX_CTO = MAX_DTO = 8), not produced by lash's client.
+// "description of commands") and Part 3 CAN (classic frames, MAX_CTO = MAX_DTO = 8), not produced by lash's client.
 #include <cstring>
 #include <vector>
 
@@ -69,7 +69,7 @@ const Bytes k20 = {0, 0, 0, 0, 0, 0, 0x34, 0x40};
 
 TEST(Xcp, ConnectResponseBytes) {
   Fixture x;
-  // Part 2 §1.6.1.1 CONNECT: FF RESOURCE COMM_MODE_BASIC MAX_CTO MAX_DTO(WORD) PROTOCOL TRANSPORT.
+  // Part 2, CONNECT: FF RESOURCE COMM_MODE_BASIC MAX_CTO MAX_DTO(WORD) PROTOCOL TRANSPORT.
   // RESOURCE = CAL/PAG (bit 0) | DAQ (bit 2) = 0x05; COMM_MODE_BASIC = OPTIONAL (bit 7) |
   // SLAVE_BLOCK_MODE (bit 6), BYTE_ORDER Intel (bit 0 = 0), granularity BYTE = 0xC0.
   EXPECT_EQ(x.one({0xFF, 0x00}), (Bytes{0xFF, 0x05, 0xC0, 0x08, 0x08, 0x00, 0x01, 0x01}));
@@ -78,7 +78,7 @@ TEST(Xcp, ConnectResponseBytes) {
 
 TEST(Xcp, CommandsBeforeConnectAreIgnored) {
   Fixture x;
-  // Part 2 §1.3: in DISCONNECTED state the slave answers CONNECT only.
+  // Part 2, state machine: in DISCONNECTED state the slave answers CONNECT only.
   EXPECT_TRUE(x.cmd({0xFD}).empty());                                        // GET_STATUS
   EXPECT_TRUE(x.cmd({0xF6, 0, 0, 0, 0x10, 0x00, 0x01, 0x00}).empty());      // SET_MTA
   EXPECT_TRUE(x.cmd({0xF0, 0x06, 1, 2, 3, 4, 5, 6}).empty());               // DOWNLOAD

@@ -11,11 +11,11 @@
 /// (dynamic configuration) are sampled by sample_event(): the owner first copies its
 /// measurements into the image, then calls it for event channel 0.
 ///
-/// Packets (Part 2 §1.1, §1.6): command CTO = [PID = command code, parameters…]; response
+/// Packets (Part 2, "the XCP packet" and "description of commands"): command CTO = [PID = command code, parameters…]; response
 /// [0xFF, …]; error [0xFE, code, …]; DAQ DTO = [PID = absolute ODT number, (timestamp,
 /// first ODT of a list only), data…]. Byte order Intel (COMM_MODE_BASIC bit 0 = 0), address
 /// granularity BYTE, MAX_CTO = MAX_DTO = 8. In DISCONNECTED state the slave answers CONNECT
-/// only and ignores every other command (Part 2 §1.3, state machine).
+/// only and ignores every other command (Part 2, the slave's state machine; Vector's XCPlite does the same).
 ///
 /// Not real-time code: the engine runs outside the control step (a node's XCP thread).
 /// on_frame/sample_event do not allocate (the DAQ pools are fixed-size arrays).
@@ -31,7 +31,7 @@
 
 namespace lash::can::xcp {
 
-// ----------------------------------------------------------------------------- codes (Part 2 §1.6)
+// ----------------------------------------------------------------------------- codes (Part 2, "description of commands")
 namespace cmd {
 inline constexpr std::uint8_t connect = 0xFF, disconnect = 0xFE, get_status = 0xFD, synch = 0xFC,
                               get_comm_mode_info = 0xFB, get_id = 0xFA, set_mta = 0xF6, upload = 0xF5,
@@ -45,7 +45,7 @@ inline constexpr std::uint8_t connect = 0xFF, disconnect = 0xFE, get_status = 0x
 inline constexpr std::uint8_t kPidResponse = 0xFF;  ///< positive response packet
 inline constexpr std::uint8_t kPidError = 0xFE;     ///< error packet
 
-/// Error codes (Part 2 §1.7.3.2, table "Error codes").
+/// Error codes (Part 2, "error handling", table of error codes).
 enum class Err : std::uint8_t {
   cmd_synch = 0x00, cmd_busy = 0x10, daq_active = 0x11, pgm_active = 0x12, cmd_unknown = 0x20, cmd_syntax = 0x21,
   out_of_range = 0x22, write_protected = 0x23, access_denied = 0x24, access_locked = 0x25, page_not_valid = 0x26,
@@ -55,7 +55,7 @@ enum class Err : std::uint8_t {
 const char* to_string(Err e) noexcept;
 
 /// Bits of CONNECT's RESOURCE and COMM_MODE_BASIC, GET_COMM_MODE_INFO's COMM_MODE_OPTIONAL,
-/// GET_STATUS's SESSION_STATUS and GET_DAQ_PROCESSOR_INFO's DAQ_PROPERTIES (Part 2 §1.6.1, §1.6.4).
+/// GET_STATUS's SESSION_STATUS and GET_DAQ_PROCESSOR_INFO's DAQ_PROPERTIES (Part 2, standard and DAQ commands).
 inline constexpr std::uint8_t kResourceCalPag = 0x01, kResourceDaq = 0x04;
 inline constexpr std::uint8_t kCommModeSlaveBlock = 0x40, kCommModeOptional = 0x80;
 inline constexpr std::uint8_t kCommOptionalMasterBlock = 0x01;
@@ -66,7 +66,7 @@ inline constexpr std::uint8_t kDaqModeTimestamp = 0x10, kDaqModePidOff = 0x20, k
 /// GET_DAQ_RESOLUTION_INFO's TIMESTAMP_MODE: size 4 bytes (bits 0–2), fixed (bit 3), unit 1 µs (bits 4–7 = 3).
 inline constexpr std::uint8_t kTimestampMode = 0x04 | 0x08 | (3 << 4);
 inline constexpr std::uint8_t kTimestampSize = 4;
-/// GET_ID identification types (Part 2 §1.6.1.6): ASCII text, A2L name without extension, EPK.
+/// GET_ID identification types (Part 2, GET_ID): ASCII text, A2L name without extension, EPK.
 inline constexpr std::uint8_t kIdAscii = 0, kIdAsamName = 1, kIdEpk = 5;
 
 inline constexpr std::uint8_t kMaxCto = 8, kMaxDto = 8;
