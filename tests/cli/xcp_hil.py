@@ -223,4 +223,15 @@ for r in rows:
     for c in master_csv_cols[:4]:
         assert float(r[c]) == float(ref[c]), (c, r, ref)
 print(f"daq: {len(rows)} consecutive samples (control steps {steps[0]}..{steps[-1]}) equal master.csv")
+assert any(e["event"] == "ccp_connected" for e in ev), "the CCP handshake must still work"
+
+# --xcp off: no slave on the bus (the tool times out), the run itself is unaffected.
+off = subprocess.Popen([LASH, "hil", "run", "--no-isolate", "--duration", "3", "--xcp", "off", "--out-dir",
+                        os.path.join(out, "off")], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+time.sleep(1.2)
+r = lash("xcp", "--bus", BUS, "--a2l", a2l, "--timeout-ms", "300", "info", check=False)
+assert r.returncode == 1 and "no response to CONNECT" in r.stderr, r.stderr
+_, err = off.communicate(timeout=60)
+assert off.returncode == 0, err
+print("--xcp off: CONNECT unanswered, run ok")
 print("ok")
