@@ -146,7 +146,7 @@ print(f"a2l: {seen['MEASUREMENT']} MEASUREMENTs, {seen['CHARACTERISTIC']} CHARAC
 
 # ----------------------------------------------------------------------------- 2.-4. live
 run_dir = os.path.join(out, "run")
-run = subprocess.Popen([LASH, "hil", "run", "--no-isolate", "--duration", "8", "--json", "--out-dir", run_dir],
+run = subprocess.Popen([LASH, "hil", "run", "--no-isolate", "--duration", "10", "--json", "--out-dir", run_dir],
                        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 time.sleep(1.5)
 
@@ -193,6 +193,25 @@ daq_csv = os.path.join(out, "daq.csv")
 d = lash("xcp", "--bus", BUS, "--a2l", a2l, "daq", *master_csv_cols, "--duration", "2", "--csv", daq_csv)
 print(d.stdout.strip())
 assert lash("xcp", "--bus", BUS, "--a2l", a2l, "get", "kp").stdout.strip() == "kp = 0.7 mA/kPa"
+# The same from Python (lash.xcp.Client over the same library), when the package is built.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(LASH)), "python"))
+try:
+    import lash.xcp as lxcp
+except ImportError as e:
+    lxcp = None
+    print(f"python: lash.xcp not importable ({e}); skipped")
+if lxcp is not None:
+    with lxcp.Client(a2l, bus=BUS) as c:
+        assert c.get("kp") == 0.7 and c.epk() == epk
+        try:
+            c.set("kp", 200.0)
+            raise AssertionError("kp = 200 must be refused")
+        except RuntimeError as e:
+            assert "ERR_OUT_OF_RANGE" in str(e), e
+        d = c.daq(["control_step", "current_mA"], 0.5)
+        cs = list(d["control_step"])
+        assert len(cs) >= 80 and all(b - a == 1 for a, b in zip(cs, cs[1:])), cs[:5]
+    print(f"python: lash.xcp.Client get/set/daq ok ({len(cs)} samples)")
 stdout, stderr = run.communicate(timeout=60)
 assert run.returncode == 0, stderr
 
