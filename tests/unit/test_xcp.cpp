@@ -1,6 +1,7 @@
 // The XCP slave engine at the byte level: every request and every expected reply below is
 // written by hand from the tables of ASAM MCD-1 XCP V1.1 Part 2 (command/response layouts,
 // "description of commands") and Part 3 CAN (classic frames, MAX_CTO = MAX_DTO = 8), not produced by lash's client.
+#include <cstdio>
 #include <cstring>
 #include <vector>
 
@@ -246,4 +247,51 @@ TEST(Xcp, DaqConfigErrors) {
   EXPECT_EQ(x.one({0xDE, 0x01, 0, 0}), (Bytes{0xFE, 0x2A}));
   EXPECT_EQ(x.one({0xE1, 0xFF, 8, 0, 0x20, 0x00, 0x01, 0x00}), (Bytes{0xFE, 0x22}));  // entry > 7 bytes (ptr at end too)
   EXPECT_EQ(x.one({0xE0, 0x20, 0, 0, 0, 0, 1, 0}), (Bytes{0xFE, 0x27}));  // PID_OFF: ERR_MODE_NOT_VALID
+}
+
+// Malformed and random command frames (seeded): never a crash, every answer a valid classic frame
+// on the response id, and the calibration objects always inside their limits — a write is whole
+// or refused. Part of the frames are well-formed DOWNLOADs of random bytes to kp's address, so
+// that both accepted and refused writes happen.
+TEST(Xcp, RandomFramesNeverBreakTheLimits) {
+  Fixture x;
+  std::uint64_t s = 0x9E3779B97F4A7C15ull;  // splitmix64, fixed seed
+  auto next = [&] {
+    std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+  };
+  std::size_t accepted = 0;
+  for (int i = 0; i < 200000; ++i) {
+    Bytes b(next() % 9);
+    for (auto& v : b) v = static_cast<std::uint8_t>(next());
+    const auto kind = next() % 8;
+    if (kind == 0) b = {0xFF, 0x00};                                          // CONNECT
+    if (kind == 1) b = {0xF6, 0, 0, 0, static_cast<std::uint8_t>(0x10 + (next() % 3) * 8), 0x00, 0x01, 0x00};
+    if (kind == 2 && !b.empty()) b[0] = static_cast<std::uint8_t>(0xEF + next() % 17);  // DOWNLOAD.. family
+    if (kind == 3) {  // mode = 0..3 (3 is out of range)
+      x.cmd({0xF6, 0, 0, 0, 0x18, 0x00, 0x01, 0x00});
+      b = {0xF0, 0x01, static_cast<std::uint8_t>(next() % 4)};
+    }
+    if (kind == 4) {  // kp = -5..15 in one block (half of them out of range)
+      const double v = static_cast<double>(next() % 2001) / 100.0 - 5.0;
+      std::uint8_t e[8];
+      std::memcpy(e, &v, 8);  // x86/ARM little-endian: the Intel byte order of the slave
+      x.cmd({0xF6, 0, 0, 0, 0x10, 0x00, 0x01, 0x00});
+      x.cmd({0xF0, 0x08, e[0], e[1], e[2], e[3], e[4], e[5]});
+      b = {0xEF, 0x02, e[6], e[7]};
+    }
+    const auto writes = x.writes.size();
+    for (const auto& r : x.cmd(b)) ASSERT_LE(r.size(), 8u);
+    accepted += x.writes.size() - writes;
+    const double kp = x.slave.get(*x.slave.find("kp"));
+    const double mode = x.slave.get(*x.slave.find("mode"));
+    ASSERT_TRUE(kp >= 0.0 && kp <= 10.0) << i;
+    ASSERT_TRUE(mode >= 0.0 && mode <= 2.0) << i;
+  }
+  EXPECT_GT(accepted, 5000u);
+  EXPECT_GT(x.slave.errors(), 10000u);
+  std::printf("random frames: %zu writes accepted, %llu error packets\n", accepted,
+              static_cast<unsigned long long>(x.slave.errors()));
 }
