@@ -12,6 +12,10 @@
 #include "lash/can/bus.hpp"
 #include "lash/hil/nodes.hpp"
 #include "lash/hil/netns.hpp"
+#include "lash/hil/xcp_server.hpp"
+
+#include <atomic>
+#include <thread>
 
 namespace {
 
@@ -83,6 +87,73 @@ void BM_HilMasterStep(benchmark::State& state) {
   state.SetLabel("master step without bus I/O: drain, plausibility check, decode, PID + DZ inverse + saturation, encode + CRC, log");
 }
 BENCHMARK(BM_HilMasterStep);
+
+// The same step with the XCP slave attached (issue 26): each step takes the newest calibration
+// page (a new one every 1000 steps) and pushes its measurements; a second thread, as the
+// master's XCP thread does, pops them, copies them into the slave's image and samples a DAQ list
+// of 5 FLOAT64 measurements (6 ODTs, sent to a sink). Goal: mean within +1 us of BM_HilMasterStep.
+void BM_HilMasterStepXcp(benchmark::State& state) {
+  BenchLayout L;
+  ScriptedBus bus;
+  MasterNode master = connected_master(L, bus);
+  auto link = std::make_unique<XcpLink>();
+  master.attach(link.get());
+  std::atomic<bool> stop{false};
+  std::atomic<std::uint64_t> dtos{0};
+  std::thread xcp_thread([&] {
+    can::xcp::Slave slave(master_xcp_config(L), [&](const can::Frame&) { dtos.fetch_add(1, std::memory_order_relaxed); });
+    auto cmd = [&](std::initializer_list<std::uint8_t> b) {
+      can::Frame f;
+      f.id = L.xcp_cmd_id;
+      f.len = static_cast<std::uint8_t>(b.size());
+      std::copy(b.begin(), b.end(), f.data.begin());
+      slave.on_frame(f);
+    };
+    // CONNECT, then one DAQ list: 5 measurements at 0x10200.. (40 bytes: 3 + 6 x 7 over 7 ODTs).
+    cmd({0xFF, 0});
+    cmd({0xD6});
+    cmd({0xD5, 0, 1, 0});
+    cmd({0xD4, 0, 0, 0, 7});
+    for (std::uint8_t k = 0; k < 7; ++k) cmd({0xD3, 0, 0, 0, k, 1});
+    std::uint32_t a = kXcpMeasurementBase;
+    for (std::uint8_t k = 0; k < 7; ++k) {
+      const std::uint8_t n = k == 0 ? 3 : (k == 6 ? 40 - 3 - 5 * 7 : 7);
+      cmd({0xE2, 0, 0, 0, k, 0});
+      cmd({0xE1, 0xFF, n, 0, static_cast<std::uint8_t>(a), static_cast<std::uint8_t>(a >> 8),
+           static_cast<std::uint8_t>(a >> 16), static_cast<std::uint8_t>(a >> 24)});
+      a += n;
+    }
+    cmd({0xE0, 0x10, 0, 0, 0, 0, 1, 0});
+    cmd({0xDE, 0x01, 0, 0});
+    MeasurementSample smp;
+    while (!stop.load(std::memory_order_relaxed)) {
+      while (link->samples.pop(smp)) {
+        for (std::size_t i = 0; i < 5; ++i)
+          slave.set(slave.config().objects[calibration_fields().size() + i], smp.page.*measurement_fields()[i].member);
+        slave.sample_event(0, static_cast<std::uint32_t>(smp.t_us));
+      }
+      std::this_thread::yield();
+    }
+  });
+  std::uint16_t c = 0;
+  CalibrationPage page = master.calibration();
+  for (auto _ : state) {
+    if ((c % 1000) == 0) {
+      page.kp = (c & 1000) ? 1.2 : 1.3;
+      link->pages.push(page);
+    }
+    bus.next = L.pack_sensors({static_cast<std::uint16_t>(17000 + (c & 255)), 0, c});
+    bus.pending = true;
+    ++c;
+    benchmark::DoNotOptimize(master.step(bus, 0.0));
+  }
+  stop.store(true);
+  xcp_thread.join();
+  state.counters["dtos_per_step"] = static_cast<double>(dtos.load()) / static_cast<double>(state.iterations());
+  state.counters["samples_lost"] = static_cast<double>(link->samples_lost.load());
+  state.SetLabel("master step with the XCP link: newest calibration page in, measurements out (lock-free queues)");
+}
+BENCHMARK(BM_HilMasterStepXcp);
 
 // One plausibility check of a received frame, as a node runs it on every frame with its input
 // identifier: DLC, CRC-8 SAE J1850 over data ID + 7 payload bytes, the DBC range of every data

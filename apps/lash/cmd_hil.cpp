@@ -114,11 +114,14 @@ Command add_hil(CLI::App& app) {
   hil->require_subcommand(1);
   auto nodes = std::make_shared<std::function<int()>>();
   auto run = std::make_shared<std::function<int()>>();
+  auto a2l = std::make_shared<std::function<int()>>();
   hilcli::add_hil_nodes(hil, *nodes);
   hilcli::add_hil_run(hil, *run);
+  hilcli::add_hil_a2l(hil, *a2l);
   return {hil, [=] {
-            const int rc = (*nodes)();
-            return rc >= 0 ? rc : (*run)();
+            int rc = (*nodes)();
+            if (rc < 0) rc = (*run)();
+            return rc >= 0 ? rc : (*a2l)();
           }};
 }
 

@@ -45,5 +45,7 @@ CLI::Option* add_duration(CLI::App* sub, double& value, const std::string& what)
 
 void add_hil_nodes(CLI::App* hil, std::function<int()>& run_selected);
 void add_hil_run(CLI::App* hil, std::function<int()>& run_selected);
+/// lash hil a2l (cmd_xcp.cpp).
+void add_hil_a2l(CLI::App* hil, std::function<int()>& run_selected);
 
 }  // namespace lash::cli::hilcli

@@ -32,6 +32,7 @@ struct MasterOptions {
   std::string events;
   std::string stats;
   double dto_timeout = 0.0;
+  std::string xcp = "on";
   int result_fd = -1;
 };
 
@@ -95,6 +96,7 @@ int run_master(const MasterOptions& o) {
   ro.duration_s = o.duration;
   ro.reference = o.reference;
   ro.dto_timeout_s = o.dto_timeout;
+  ro.xcp = o.xcp == "on";
   (void)hil::parse_reference(o.reference);
   (void)hil::steps_for(o.duration, s.step_s, "--duration");
   hil::install_node_signal_handlers();
@@ -105,7 +107,7 @@ int run_master(const MasterOptions& o) {
   if (!o.bus_log.empty()) hil::write_bus_log(o.bus_log, r);
   hil::write_events(
       o.events.empty() ? (std::filesystem::path(o.log).replace_extension("").string() + ".events.csv") : o.events,
-      r.events);
+      r.events, r.calibration);
   if (!o.stats.empty()) write_text(o.stats, hil::master_stats_json(r, o.reference));
   for (const auto& e : r.events)
     fmt::print(stderr, "lash hil master: t = {:.3f} s (step {}): {}\n", e.t_s, e.step, to_string(e.kind));
@@ -196,6 +198,8 @@ void add_hil_nodes(CLI::App* hil, std::function<int()>& run_selected) {
   master->add_option("--stats", mo->stats, "Statistics JSON");
   master->add_option("--dto-timeout", mo->dto_timeout, "Give up without a DTO reply after this long [s] (0 = from the settings)")
       ->check(CLI::Range(0.0, 3600.0));
+  master->add_option("--xcp", mo->xcp, "XCP-on-CAN slave for calibration and DAQ (docs/xcp.md): on | off")
+      ->check(CLI::IsMember({"on", "off"}));
   master->add_option("--result-fd", mo->result_fd, "")->group("");
 
   auto lo = std::make_shared<LatencyOptions>();

@@ -24,6 +24,7 @@ struct RunOptions {
   bool restart_slave = false;
   std::int64_t seed = -1;
   int slave_cpu = -1;
+  std::string xcp = "on";
 };
 
 struct SimulateOptions {
@@ -134,6 +135,7 @@ int run_run(const RunOptions& o) {
   so.out_dir = o.out_dir;
   so.isolate = !o.no_isolate;
   so.restart_slave = o.restart_slave;
+  so.xcp = o.xcp == "on";
   so.validate();
   hil::install_session_signal_handlers();
   hil::Session session(so);
@@ -225,6 +227,8 @@ void add_hil_run(CLI::App* hil, std::function<int()>& run_selected) {
   run->add_flag("--restart-slave", ro->restart_slave, "Watchdog: start a slave that died again (the report shows the gap)");
   run->add_option("--slave-cpu", ro->slave_cpu, "Pin the slave to this CPU (-1 = as --cpu, which pins the master)")
       ->check(CLI::Range(-1, 4095));
+  run->add_option("--xcp", ro->xcp, "The master's XCP-on-CAN slave (docs/xcp.md): on | off")
+      ->check(CLI::IsMember({"on", "off"}));
 
   auto sio = std::make_shared<SimulateOptions>();
   auto* sim = hil->add_subcommand("simulate", "Closed-loop simulation through the nodes' step functions");

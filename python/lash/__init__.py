@@ -25,8 +25,9 @@ from ._lash import (  # noqa: F401  (re-exported)
 )
 from ._lash import _sweep_csv
 from . import can  # noqa: F401
+from . import xcp  # noqa: F401
 
-__all__ = ["BacklashInverse", "DeadzoneInverse", "Estimator", "InputError", "Plant", "Result", "estimate", "read_record", "signal", "sweep", "can"]
+__all__ = ["BacklashInverse", "DeadzoneInverse", "Estimator", "InputError", "Plant", "Result", "estimate", "read_record", "signal", "sweep", "can", "xcp"]
 __version__ = "0.1.0"
 
 InputError.__doc__ = (

@@ -2,6 +2,7 @@ from ._lash import (BacklashInverse as BacklashInverse, DeadzoneInverse as Deadz
                     Estimator as Estimator, InputError as InputError, Plant as Plant, Result as Result,
                     estimate as estimate, read_record as read_record, signal as signal)
 from . import can as can
+from . import xcp as xcp
 
 __version__: str
 

@@ -30,6 +30,10 @@ BenchLayout BenchLayout::from_dbc(const std::filesystem::path& dbc_file) {
   static_cast<can::ccp::Layout&>(L) = can::ccp::Layout::from_dbc(db, file);
   L.command_id = cmd.id;
   L.sensors_id = sen.id;
+  // XCP on CAN (optional messages; defaults 0x7F0 / 0x7F1): the calibration tool's commands
+  // and the master ECU's responses and DAQ packets.
+  if (db.message("XCP_CMD")) L.xcp_cmd_id = can::standard_message(db, "XCP_CMD", file).id;
+  if (db.message("XCP_RES")) L.xcp_res_id = can::standard_message(db, "XCP_RES", file).id;
   L.command_len = can::classic_length(cmd, file);
   L.sensors_len = can::classic_length(sen, file);
   L.solenoid_a = BitField::from_message(cmd, "SolenoidA_Current", file);

@@ -17,6 +17,7 @@
 #include "lash/io/csv.hpp"
 #include "lash/io/error.hpp"
 #include "lash/rt/dma_latency.hpp"
+#include "lash/hil/xcp_server.hpp"
 #include "lash/io/numeric.hpp"
 #include "json_parts.hpp"
 
@@ -218,6 +219,16 @@ MasterRun run_master_node(const BenchSettings& s, const MasterRunOptions& o, con
   mc.log_capacity = steps;
   MasterNode master(L, mc);
   rt::PeriodicLoop loop(make_loop_config(o.loop, steps));
+  // The XCP slave: its own thread and socket; the step meets it through two lock-free queues.
+  // Started before the loop's real-time settings, so that it keeps the default scheduler and
+  // every CPU (a thread inherits SCHED_FIFO and the affinity of the thread that creates it).
+  std::unique_ptr<XcpLink> link;
+  std::unique_ptr<XcpServer> xcp;
+  if (o.xcp) {
+    link = std::make_unique<XcpLink>();
+    xcp = std::make_unique<XcpServer>(s.bus, L, *link, initial_calibration(mc));
+    master.attach(link.get());
+  }
   MasterRun out;
   out.loop.warnings = loop.apply_realtime_settings();
   auto bus = open_node_bus(s.bus, L, true);
@@ -236,6 +247,17 @@ MasterRun run_master_node(const BenchSettings& s, const MasterRunOptions& o, con
   }
   out.stats.epoch_s = realtime_now_s() - static_cast<double>(rt::monotonic_ns() - loop.start_ns()) * 1e-9;
   out.stats.period_ns = loop.config().period_ns;
+  if (xcp) {
+    xcp->stop();
+    const XcpServerStats xs = xcp->stats();
+    out.stats.xcp = true;
+    out.stats.xcp_commands = xs.commands;
+    out.stats.xcp_errors = xs.errors;
+    out.stats.xcp_dtos = xs.dtos;
+    out.stats.xcp_samples_lost = xs.samples_lost;
+    out.stats.xcp_pages = xs.pages;
+  }
+  out.calibration.assign(master.calibration_events().begin(), master.calibration_events().end());
   take_loop(loop, out.loop);
   out.log.assign(master.log().begin(), master.log().end());
   out.events.assign(master.events().begin(), master.events().end());
@@ -312,7 +334,8 @@ void write_slave_csv(const std::filesystem::path& path, const SlaveRun& r) {
 }
 
 void write_master_csv(const std::filesystem::path& path, const MasterRun& r) {
-  std::vector<std::vector<double>> c(16);
+  const auto cal = calibration_fields();
+  std::vector<std::vector<double>> c(16 + cal.size());
   const std::size_t n = std::min(r.log.size(), r.loop.records.size());
   for (std::size_t i = 0; i < n; ++i) {
     const auto& l = r.log[i];
@@ -323,13 +346,14 @@ void write_master_csv(const std::filesystem::path& path, const MasterRun& r) {
                           static_cast<double>(l.sensor_seq), static_cast<double>(l.dropped), l.current_mA, l.integrator_mA,
                           l.command_sent ? static_cast<double>(l.command_counter) : -1.0,
                           us(rec.tet_ns), us(rec.io_ns), us(rec.wake_latency_ns)};
-    for (std::size_t j = 0; j < c.size(); ++j) c[j].push_back(row[j]);
+    for (std::size_t j = 0; j < 16; ++j) c[j].push_back(row[j]);
+    for (std::size_t j = 0; j < cal.size(); ++j) c[16 + j].push_back(l.calibration.*cal[j].member);
   }
-  write_columns(path,
-                {"step", "t_s", "state", "control_step", "reference_kPa", "measured_kPa", "sensor_counter",
-                 "sensor_fresh", "sensor_seq", "dropped", "current_mA", "integrator_mA", "command_counter", "tet_us", "io_us",
-                 "wake_latency_us"},
-                c);
+  std::vector<std::string> names{"step", "t_s", "state", "control_step", "reference_kPa", "measured_kPa", "sensor_counter",
+                                 "sensor_fresh", "sensor_seq", "dropped", "current_mA", "integrator_mA", "command_counter",
+                                 "tet_us", "io_us", "wake_latency_us"};
+  for (const auto& f : cal) names.emplace_back(f.name);  // the calibration page of each step (calibration.hpp)
+  write_columns(path, names, c);
 }
 
 void write_events(const std::filesystem::path& path, const std::vector<NodeEvent>& events) {
@@ -338,6 +362,25 @@ void write_events(const std::filesystem::path& path, const std::vector<NodeEvent
   for (const auto& e : events)
     f.stream() << e.step << ',' << format_double(e.t_s) << ',' << to_string(e.kind) << ',' << to_string(e.from) << ','
                << to_string(e.to) << '\n';
+  f.commit();
+}
+
+void write_events(const std::filesystem::path& path, const std::vector<NodeEvent>& events,
+                  const std::vector<CalibrationEvent>& calibration) {
+  AtomicFile f(path);
+  f.stream() << "step,t_s,event,from,to,name,old,new\n";
+  std::size_t j = 0;
+  const auto fields = calibration_fields();
+  auto cal_row = [&](const CalibrationEvent& c) {
+    f.stream() << c.step << ',' << format_double(c.t_s) << ",calibration,,," << fields[c.field].name << ','
+               << format_double(c.old_value) << ',' << format_double(c.new_value) << '\n';
+  };
+  for (const auto& e : events) {
+    while (j < calibration.size() && calibration[j].step < e.step) cal_row(calibration[j++]);
+    f.stream() << e.step << ',' << format_double(e.t_s) << ',' << to_string(e.kind) << ',' << to_string(e.from) << ','
+               << to_string(e.to) << ",,,\n";
+  }
+  while (j < calibration.size()) cal_row(calibration[j++]);
   f.commit();
 }
 
@@ -403,6 +446,10 @@ std::string master_stats_json(const MasterRun& r, const std::string& reference) 
   j["handshake_s"] = r.stats.handshake_s;
   j["events"] = detail::events_json(r.events);
   j["reference"] = reference;
+  if (r.stats.xcp)
+    j["xcp"] = {{"commands", r.stats.xcp_commands}, {"errors", r.stats.xcp_errors}, {"dtos", r.stats.xcp_dtos},
+                {"samples_lost", r.stats.xcp_samples_lost}, {"pages", r.stats.xcp_pages},
+                {"calibration_events", r.calibration.size()}};
   return j.dump(2) + "\n";
 }
 
@@ -522,6 +569,7 @@ void write_run(int fd, const MasterRun& run) {
   w.vec(run.log);
   w.vec(run.events);
   w.vec(run.bus_log);
+  w.vec(run.calibration);
 }
 
 bool read_run(int fd, SlaveRun& run) {
@@ -531,7 +579,8 @@ bool read_run(int fd, SlaveRun& run) {
 
 bool read_run(int fd, MasterRun& run) {
   Reader r(fd);
-  return read_common(r, run.stats, run.loop) && r.vec(run.log) && r.vec(run.events) && r.vec(run.bus_log);
+  return read_common(r, run.stats, run.loop) && r.vec(run.log) && r.vec(run.events) && r.vec(run.bus_log) &&
+         r.vec(run.calibration);
 }
 
 }  // namespace lash::hil

@@ -251,6 +251,38 @@ MasterNode::MasterNode(const BenchLayout& layout, MasterConfig config)
   ramp_step_mA_ = cfg_.e2e.ramp_mA_per_s * cfg_.controller.pid.dt_s;
   log_.resize(cfg_.log_capacity);
   bus_log_.resize(cfg_.bus_log_capacity ? cfg_.bus_log_capacity : 4 * cfg_.log_capacity + 64);
+  cal_ = initial_calibration(cfg_);
+  cal_events_.resize(1024);
+}
+
+CalibrationPage initial_calibration(const MasterConfig& c) noexcept {
+  CalibrationPage p;
+  const PidGains& g = c.law ? c.law->pid.gains : c.controller.pid.gains;
+  p.kp = g.kp;
+  p.ki_per_s = g.ki_per_s;
+  p.kd_s = g.kd_s;
+  p.n_per_s = g.n_per_s;
+  p.dz_right_mA = c.controller.dz_inverse.offset_right;
+  p.dz_left_mA = c.controller.dz_inverse.offset_left;
+  return p;
+}
+
+// A new calibration page at a step boundary: the law's gains, the bench controller's inverse
+// edges and the reference offset change together, before the step's law runs; one event per
+// object that changed.
+void MasterNode::apply_calibration(const CalibrationPage& p, double now_s) noexcept {
+  const auto fields = calibration_fields();
+  for (std::size_t i = 0; i < fields.size(); ++i) {
+    const double before = cal_.*fields[i].member, after = p.*fields[i].member;
+    if (before == after) continue;
+    if (n_cal_events_ < cal_events_.size())
+      cal_events_[n_cal_events_++] = CalibrationEvent{k_, now_s, static_cast<std::uint16_t>(i), before, after};
+  }
+  cal_ = p;
+  const PidGains g{p.kp, p.ki_per_s, p.kd_s, p.n_per_s};
+  controller_.pid().set_gains(g);
+  if (pid_) pid_->set_gains(g);
+  controller_.deadzone_inverse().set_offsets(p.dz_right_mA, p.dz_left_mA);
 }
 
 void MasterNode::go(MasterState to, NodeEventKind why, double now_s) noexcept {
@@ -278,6 +310,18 @@ void MasterNode::send(can::Bus& bus, const can::Frame& f, double now_s) noexcept
 
 bool MasterNode::step(can::Bus& bus, double now_s) noexcept {
   if (state_ == MasterState::failed) return false;
+  // 0. Step boundary: the newest calibration page (XCP thread, or the replayed schedule).
+  if (link_) {
+    CalibrationPage p;
+    bool got = false;
+    while (link_->pages.pop(p)) got = true;
+    if (got && !(p == cal_)) apply_calibration(p, now_s);
+  }
+  while (next_change_ < cfg_.calibration_schedule.size() &&
+         cfg_.calibration_schedule[next_change_].control_step <= m_ + 1) {
+    const CalibrationPage& p = cfg_.calibration_schedule[next_change_++].page;
+    if (!(p == cal_)) apply_calibration(p, now_s);
+  }
   // 1. Read what arrived since the last step (bounded); check every sensor frame.
   bool dto = false;
   fresh_ = bad_ = false;
@@ -337,7 +381,7 @@ bool MasterNode::step(can::Bus& bus, double now_s) noexcept {
   double r = 0.0;
   if (send_cmd) {
     ++m_;
-    r = reference_.next();
+    r = reference_.next() + cal_.reference_offset_kPa;
     control(bus, r, now_s);
   }
   if (send_cmd) {
@@ -367,6 +411,21 @@ bool MasterNode::step(can::Bus& bus, double now_s) noexcept {
     }
     l.command_counter = static_cast<std::uint16_t>(cmd_counter_ - (send_cmd ? 1 : 0));
     l.command_sent = send_cmd;
+    l.calibration = cal_;
+  }
+  if (link_) {  // DAQ event channel 0: this step's measurements (never waits; a full queue is counted)
+    MeasurementSample m;
+    m.step = k_;
+    m.t_us = static_cast<std::int64_t>(std::llround(now_s * 1e6));
+    m.page.reference_kPa = r;
+    m.page.measured_kPa = measured_kPa_;
+    m.page.current_mA = send_cmd ? current_mA_ : 0.0;
+    m.page.integrator_mA = pid_ ? pid_->integrator() : controller_.pid().integrator();
+    m.page.control_step = static_cast<double>(m_);
+    m.page.state = static_cast<double>(state_);
+    m.page.sensor_fresh = fresh_ ? 1.0 : 0.0;
+    m.page.dropped = static_cast<double>(dropped);
+    if (!link_->samples.push(m)) link_->samples_lost.fetch_add(1, std::memory_order_relaxed);
   }
   ++k_;
   return state_ != MasterState::failed;

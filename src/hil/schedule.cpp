@@ -1,5 +1,7 @@
 #include "lash/hil/schedule.hpp"
 
+#include <fstream>
+
 #include <cmath>
 #include <deque>
 #include <stdexcept>
@@ -77,6 +79,32 @@ std::int64_t integer_cell(const Table& t, std::string_view col, std::size_t row,
   return static_cast<std::int64_t>(v);
 }
 
+// The calibration columns of a master.csv (calibration_fields(), when the log has them): the
+// page of the first control step and every change after it.
+void read_calibration(const std::filesystem::path& master_csv, FrameSchedule& s) {
+  std::string header;
+  {
+    std::ifstream in(master_csv);
+    std::getline(in, header);
+  }
+  const auto fields = calibration_fields();
+  if (header.find(std::string(",") + fields[0].name + ",") == std::string::npos &&
+      header.find(std::string(",") + fields[0].name) == std::string::npos)
+    return;
+  TableOptions o;
+  o.columns = {"control_step"};
+  for (const auto& f : fields) o.columns.emplace_back(f.name);
+  o.strict = true;
+  const Table t = read_table(master_csv, o);
+  for (std::size_t i = 0; i < t.rows(); ++i) {
+    const std::int64_t c = integer_cell(t, "control_step", i, -1);
+    if (c < 0) continue;
+    CalibrationPage p;
+    for (const auto& f : fields) p.*f.member = t[f.name][i];
+    if (s.calibration.empty() || !(s.calibration.back().page == p)) s.calibration.push_back({c, p});
+  }
+}
+
 }  // namespace
 
 FrameSchedule ideal_schedule(std::size_t control_steps) {
@@ -91,7 +119,11 @@ FrameSchedule ideal_schedule(std::size_t control_steps) {
 FrameSchedule observed_schedule(const std::vector<MasterStepLog>& master, const std::vector<SlaveStepLog>& slave) {
   FrameSchedule s;
   for (const auto& l : master)
-    if (l.control_step >= 0) s.master.push_back(FrameUse{l.sensor_seq, l.dropped > 0});
+    if (l.control_step >= 0) {
+      s.master.push_back(FrameUse{l.sensor_seq, l.dropped > 0});
+      if (s.calibration.empty() || !(s.calibration.back().page == l.calibration))
+        s.calibration.push_back({l.control_step, l.calibration});
+    }
   for (const auto& l : slave)
     s.slave.push_back(FrameUse{l.command_fresh ? static_cast<std::int64_t>(l.command_counter) : -1, l.dropped > 0});
   return s;
@@ -115,6 +147,7 @@ FrameSchedule read_schedule(const std::filesystem::path& master_csv, const std::
                        "control steps must count 0, 1, 2, … (expected " + std::to_string(s.master.size()) + ")");
     s.master.push_back(FrameUse{integer_cell(m, "sensor_seq", i, -1), integer_cell(m, "dropped", i, 0) > 0});
   }
+  read_calibration(master_csv, s);
   if (s.master.empty()) throw InputError(m.file, 0, "control_step", "no control step (control_step >= 0) in the log");
   for (std::size_t i = 0; i < sl.rows(); ++i) {
     if (integer_cell(sl, "step", i, 0) != static_cast<std::int64_t>(i))
@@ -150,6 +183,7 @@ SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& m
   const std::size_t N = schedule.master.size();
   MasterConfig mc = master_cfg;
   mc.log_capacity = N + 1;
+  if (!schedule.calibration.empty()) mc.calibration_schedule = schedule.calibration;
   SlaveConfig sc = slave_cfg;
   sc.log_capacity = std::max(N, schedule.slave.size());
   MasterNode master(layout, mc);

@@ -302,6 +302,7 @@ RunReport Session::run(const std::function<void(const std::string&)>& progress) 
                              (dir / "master.csv").string(), "--bus-log", (dir / "master_bus.log").string(),
                              "--events", (dir / "master.events.csv").string(), "--stats",
                              (dir / "master.json").string()});
+  if (!o_.xcp) margs.insert(margs.end(), {"--xcp", "off"});
   Child master = spawn(o_.executable, margs, false, "lash-hil-master");
 
   // Supervise.
@@ -362,8 +363,12 @@ RunReport Session::run(const std::function<void(const std::string&)>& progress) 
   rep.interrupt_signal = forwarded > 0 ? forwarded : 0;
 
   std::vector<MasterStepLog> simulated;
-  if (have_master && mrun.stats.control_steps > 0)
-    simulated = simulate_bench(L, mc, sc, ideal_schedule(static_cast<std::size_t>(mrun.stats.control_steps))).master;
+  if (have_master && mrun.stats.control_steps > 0) {
+    // The ideal frame schedule, with the calibration writes the run logged (XCP) at their steps.
+    FrameSchedule ideal = ideal_schedule(static_cast<std::size_t>(mrun.stats.control_steps));
+    ideal.calibration = observed_schedule(mrun.log, {}).calibration;
+    simulated = simulate_bench(L, mc, sc, ideal).master;
+  }
   make_run_report(rep, have_master ? &mrun : nullptr, sruns, simulated,
                   o_.settings.scenario ? &*o_.settings.scenario : nullptr);
   if (!simulated.empty()) {  // the same closed loop, fed the frames each node logged it used

@@ -223,3 +223,70 @@ TEST(HilSchedule, ReadScheduleFromLogs) {
   }
   std::filesystem::remove_all(dir);
 }
+
+// XCP calibration (hil/calibration.hpp): a page handed over through the XcpLink before step k is
+// in force from step k on (the step boundary), each changed object is one event with its old and
+// new value, the reference offset moves the square reference by exactly that much, and the
+// replay of the logged schedule (which carries the pages) equals the run bit for bit.
+TEST(HilSchedule, CalibrationPageAtTheStepBoundaryAndItsReplay) {
+  const BenchLayout L;
+  constexpr std::size_t N = 400, K = 200;
+  MasterConfig mc = master_cfg();
+  mc.log_capacity = N + 1;
+  SlaveConfig sc = slave_cfg();
+  sc.log_capacity = N;
+  MasterNode master(L, mc);
+  SlaveNode slave(L, sc);
+  auto xl = std::make_unique<XcpLink>();
+  master.attach(xl.get());
+  MemLink link;
+  master.step(link.a(), 0.0);
+  ASSERT_TRUE(slave.wait_connect(link.b(), std::chrono::nanoseconds(0)));
+  for (std::size_t k = 1; k <= N; ++k) {
+    const double t = static_cast<double>(k) * kT;
+    if (k == K) {
+      CalibrationPage p = master.calibration();
+      p.kp = 0.7;
+      p.reference_offset_kPa = 50.0;
+      ASSERT_TRUE(xl->pages.push(p));
+    }
+    slave.step(link.b(), t - 0.5 * kT);
+    master.step(link.a(), t);
+  }
+  const std::vector<MasterStepLog> log(master.log().begin(), master.log().end());
+  for (std::size_t k = 1; k <= N; ++k) {
+    const bool after = k >= K;
+    ASSERT_EQ(log[k].calibration.kp, after ? 0.7 : 1.2) << k;
+    ASSERT_EQ(log[k].calibration.ki_per_s, 12.0) << k;
+    // The square reference of master_cfg() is 900 ± 400 kPa (900 where the sine crosses 0).
+    const double r = log[k].reference_kPa - (after ? 50.0 : 0.0);
+    ASSERT_TRUE(r == 500.0 || r == 900.0 || r == 1300.0) << k << " " << log[k].reference_kPa;
+  }
+  const auto ev = master.calibration_events();
+  ASSERT_EQ(ev.size(), 2u);
+  EXPECT_EQ(std::string(calibration_fields()[ev[0].field].name), "kp");
+  EXPECT_EQ(ev[0].old_value, 1.2);
+  EXPECT_EQ(ev[0].new_value, 0.7);
+  EXPECT_EQ(ev[0].step, K);
+  EXPECT_EQ(std::string(calibration_fields()[ev[1].field].name), "reference_offset_kPa");
+  EXPECT_EQ(ev[1].new_value, 50.0);
+  // Every step pushed its measurements (one per step, nothing lost).
+  MeasurementSample smp;
+  std::size_t n = 0;
+  while (xl->samples.pop(smp)) ++n;
+  EXPECT_EQ(n, N + 1);
+  EXPECT_EQ(xl->samples_lost.load(), 0u);
+
+  SimulationResult run;
+  run.master = log;
+  run.slave.assign(slave.log().begin(), slave.log().end());
+  const FrameSchedule fs = observed_schedule(run.master, run.slave);
+  ASSERT_EQ(fs.calibration.size(), 2u);  // the first control step's page, and the change
+  EXPECT_EQ(fs.calibration[1].control_step, log[K].control_step);
+  expect_same(run, simulate_bench(L, mc, sc, fs));
+  // Without the pages the replay departs from the run after step K (the write mattered).
+  FrameSchedule without = fs;
+  without.calibration.clear();
+  const SimulationResult other = simulate_bench(L, mc, sc, without);
+  EXPECT_NE(other.master[N].current_mA, run.master[N].current_mA);
+}

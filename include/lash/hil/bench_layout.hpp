@@ -78,6 +78,7 @@ struct SensorMsg {
 /// (cro_id, dto_id, pack_connect, is_connect, is_connect_ack from can::ccp::Layout).
 struct BenchLayout : can::ccp::Layout {
   std::uint32_t command_id = 0x100, sensors_id = 0x200;
+  std::uint32_t xcp_cmd_id = 0x7F0, xcp_res_id = 0x7F1;  ///< XCP on CAN: CAN_ID_MASTER / CAN_ID_SLAVE (XCP_CMD / XCP_RES)
   std::uint8_t command_len = 8, sensors_len = 8;
   // Defaults: the layout of config/hydraulic_bench.dbc.
   BitField solenoid_a{0, 16, 0.1, 0, 2000}, solenoid_b{16, 16, 0.1, 0, 2000}, restrictor{32, 16, 0.1, 0, 2000},

@@ -85,6 +85,8 @@ struct NodeStats {
   std::int64_t control_steps = 0;
   double handshake_s = -1.0;
   CompensationState compensation;  ///< the scenario law's compensator at the end (on = false without one)
+  bool xcp = false;                ///< the XCP slave ran (xcp_server.hpp)
+  std::uint64_t xcp_commands = 0, xcp_errors = 0, xcp_dtos = 0, xcp_samples_lost = 0, xcp_pages = 0;
   // slave only
   bool connected = false;
   std::uint64_t dto_replies = 0;
@@ -111,6 +113,7 @@ struct MasterRun {
   std::vector<MasterStepLog> log;
   std::vector<NodeEvent> events;     ///< the safe-state machine's transitions and the handshake
   std::vector<LoggedFrame> bus_log;  ///< timestamps as the node saw them (see write_bus_log)
+  std::vector<CalibrationEvent> calibration;  ///< XCP writes that took effect (calibration.hpp)
 };
 
 struct SlaveRunOptions {
@@ -124,6 +127,7 @@ struct MasterRunOptions {
   double duration_s = 10.0;         ///< control time after the handshake [s]
   std::string reference = "step:from=500,to=1500,time=1";
   double dto_timeout_s = 0.0;       ///< 0 = from the settings
+  bool xcp = true;                  ///< run the XCP-on-CAN slave (`--xcp on|off`, docs/xcp.md)
 };
 
 /// Runs the slave: waits for a CCP CONNECT (polling `stop`), then steps until `stop`, the
@@ -143,6 +147,10 @@ void write_slave_csv(const std::filesystem::path& path, const SlaveRun& r);
 void write_master_csv(const std::filesystem::path& path, const MasterRun& r);
 /// A node's events CSV: `step,t_s,event,from,to`.
 void write_events(const std::filesystem::path& path, const std::vector<NodeEvent>& events);
+/// The master's events CSV: `step,t_s,event,from,to,name,old,new`, the state events and the
+/// calibration writes (event `calibration`, the object's name, its old and new value) in step order.
+void write_events(const std::filesystem::path& path, const std::vector<NodeEvent>& events,
+                  const std::vector<CalibrationEvent>& calibration);
 /// candump -L log of the frames the master sent and received, in wall-clock seconds: a sent
 /// frame carries its loop time (added to the loop's epoch), a received one the bus's receive
 /// timestamp, which is wall-clock already.

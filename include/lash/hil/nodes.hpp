@@ -41,6 +41,7 @@
 #include "lash/control/adaptive_compensator.hpp"
 #include "lash/control/controller.hpp"
 #include "lash/hil/bench_layout.hpp"
+#include "lash/hil/calibration.hpp"
 #include "lash/hil/e2e.hpp"
 #include "lash/rigs/pilot_valve_model.hpp"
 #include "lash/rigs/pilot_valve_rig.hpp"
@@ -254,7 +255,18 @@ struct MasterConfig {
   std::size_t bus_log_capacity = 0;        ///< frames logged (preallocated); 0 → 4·log_capacity + 64
   E2EConfig e2e;                           ///< plausibility, recovery and ramp settings
   std::optional<CompensatedLaw> law;       ///< a scenario's law instead of `controller`'s PID + fixed offset
+  /// Calibration pages to apply (the replay of a run with XCP writes, schedule.hpp): page p of
+  /// control step m takes effect at the start of the step that runs control step m. In time order.
+  struct CalibrationChange {
+    std::int64_t control_step = 0;
+    CalibrationPage page;
+  };
+  std::vector<CalibrationChange> calibration_schedule;
 };
+
+/// The calibration page of a master configuration before any write (the law's gains, the bench
+/// controller's inverse edges, no reference offset).
+CalibrationPage initial_calibration(const MasterConfig& c) noexcept;
 
 struct MasterStepLog {
   std::uint32_t step = 0;                  ///< loop step k
@@ -273,6 +285,7 @@ struct MasterStepLog {
   bool command_sent = false;
   double inverse_right_mA = 0.0;           ///< scenario law: the deadzone inverse's edges after the step [mA]
   double inverse_left_mA = 0.0;            ///< (left as a negative current; 0 without a scenario or for none)
+  CalibrationPage calibration;             ///< the calibration page the step ran with (calibration.hpp)
 };
 
 class MasterNode {
@@ -298,6 +311,13 @@ class MasterNode {
   double handshake_s() const noexcept { return handshake_s_; }  ///< first CRO → DTO [s]; −1 before
   /// The scenario law's compensator at this point (on = false without a scenario).
   CompensationState compensation() const noexcept;
+  /// Connects the step to an XCP thread (hil/xcp_server.hpp): each step first takes the newest
+  /// calibration page the thread handed over, and ends by pushing its measurements. nullptr
+  /// detaches. Not real-time safe (call before the loop).
+  void attach(XcpLink* link) noexcept { link_ = link; }
+  const CalibrationPage& calibration() const noexcept { return cal_; }
+  /// Calibration writes that took effect, one event per changed object.
+  std::span<const CalibrationEvent> calibration_events() const noexcept { return {cal_events_.data(), n_cal_events_}; }
 
  private:
   void go(MasterState to, NodeEventKind why, double now_s) noexcept;
@@ -307,6 +327,7 @@ class MasterNode {
   void control_states(can::Bus& bus, double r, double now_s) noexcept;
   double law(double r, double y) noexcept;
   void reset_law() noexcept;
+  void apply_calibration(const CalibrationPage& p, double now_s) noexcept;
   BenchLayout layout_;
   MasterConfig cfg_;
   ClosedLoopDiscrete controller_;
@@ -336,6 +357,11 @@ class MasterNode {
   std::vector<LoggedFrame> bus_log_;
   std::size_t n_bus_log_ = 0;
   std::uint64_t bus_log_dropped_ = 0;
+  CalibrationPage cal_;
+  XcpLink* link_ = nullptr;
+  std::size_t next_change_ = 0;
+  std::vector<CalibrationEvent> cal_events_;
+  std::size_t n_cal_events_ = 0;
 };
 
 }  // namespace lash::hil

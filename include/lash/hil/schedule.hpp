@@ -36,6 +36,11 @@ struct FrameUse {
 struct FrameSchedule {
   std::vector<FrameUse> master;  ///< by control step m = 0, 1, …
   std::vector<FrameUse> slave;   ///< by slave step s = 0, 1, …
+  /// The master's calibration page where it changed (XCP writes, calibration.hpp): the page of
+  /// the first control step and of every control step whose page differs from the one before.
+  /// simulate_bench applies them through MasterConfig::calibration_schedule. Empty for logs
+  /// without calibration columns.
+  std::vector<MasterConfig::CalibrationChange> calibration;
 };
 
 /// The schedule of simulate_bench: master m uses slave frame m, slave s uses command s − 1.

@@ -34,6 +34,7 @@ struct SessionOptions {
   int slave_cpu = -1;                    ///< −1: as loop.cpu
   double duration_s = 5.0;               ///< control time [s]
   std::string reference = "step:from=500,to=1500,time=1";
+  bool xcp = true;                        ///< the master's XCP slave (`--xcp off` disables it)
   std::filesystem::path out_dir = "hil-out";
   bool isolate = true;                   ///< private network namespace (else the host's network)
   bool restart_slave = false;            ///< watchdog: start a dead slave again

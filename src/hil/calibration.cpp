@@ -1,0 +1,45 @@
+#include "lash/hil/calibration.hpp"
+
+#include <array>
+
+namespace lash::hil {
+
+namespace {
+// Limits: what the law accepts (gains finite and >= 0, edges inside the current range) with a
+// margin a tuning session needs; the defaults of config/control/lash_gains.toml lie well inside.
+constexpr std::array<CalibrationField, 7> kCalibration{{
+    {"kp", &CalibrationPage::kp, "mA/kPa", 0.0, 100.0, "PID proportional gain Kp"},
+    {"ki_per_s", &CalibrationPage::ki_per_s, "mA/(kPa s)", 0.0, 10000.0, "PID integral gain Ki"},
+    {"kd_s", &CalibrationPage::kd_s, "mA s/kPa", 0.0, 10.0, "PID derivative gain Kd"},
+    {"n_per_s", &CalibrationPage::n_per_s, "1/s", 0.0, 100000.0, "PID derivative filter N (0 = unfiltered)"},
+    {"dz_right_mA", &CalibrationPage::dz_right_mA, "mA", 0.0, 2000.0,
+     "deadzone inverse: nominal right edge (bench controller)"},
+    {"dz_left_mA", &CalibrationPage::dz_left_mA, "mA", 0.0, 2000.0,
+     "deadzone inverse: nominal left edge, magnitude (bench controller)"},
+    {"reference_offset_kPa", &CalibrationPage::reference_offset_kPa, "kPa", -4000.0, 4000.0,
+     "offset added to the reference r(m)"},
+}};
+
+constexpr std::array<MeasurementField, 8> kMeasurements{{
+    {"reference_kPa", &MeasurementPage::reference_kPa, "kPa", -5000.0, 5000.0, "reference r(m)"},
+    {"measured_kPa", &MeasurementPage::measured_kPa, "kPa", -5000.0, 5000.0, "decoded pilot pressure y(m)"},
+    {"current_mA", &MeasurementPage::current_mA, "mA", -2000.0, 2000.0, "commanded current i(m)"},
+    {"integrator_mA", &MeasurementPage::integrator_mA, "mA", -1e6, 1e6, "PID integrator state"},
+    {"control_step", &MeasurementPage::control_step, "", -1.0, 4e9, "control step m (-1 before the handshake)"},
+    {"state", &MeasurementPage::state, "", 0.0, 5.0, "safe-state machine state (docs/hil.md)"},
+    {"sensor_fresh", &MeasurementPage::sensor_fresh, "", 0.0, 1.0, "a plausible new sensor frame was used"},
+    {"dropped", &MeasurementPage::dropped, "", 0.0, 64.0, "implausible sensor frames dropped in the step"},
+}};
+}  // namespace
+
+std::span<const CalibrationField> calibration_fields() noexcept { return kCalibration; }
+
+const CalibrationField* find_calibration_field(std::string_view name) noexcept {
+  for (const auto& f : kCalibration)
+    if (name == f.name) return &f;
+  return nullptr;
+}
+
+std::span<const MeasurementField> measurement_fields() noexcept { return kMeasurements; }
+
+}  // namespace lash::hil
