@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
         add_sweep(app),
         add_can(app),
         add_hil(app),
+        add_monitor(app),
     };
     try {
       app.parse(argc, argv);
