@@ -118,7 +118,7 @@ void EventDetector::update(double t, const std::vector<ParamValue>& params, std:
     auto it = tracks_.find(p.name);
     if (it == tracks_.end())
       it = tracks_.emplace(p.name, Track{false, 1.0, PageHinkley({s_.drift.delta, s_.drift.threshold}), false,
-                                         std::numeric_limits<double>::quiet_NaN()})
+                                         std::numeric_limits<double>::quiet_NaN(), {}, 0})
                .first;
     Track& tr = it->second;
     for (const Threshold& th : s_.thresholds) {
@@ -134,11 +134,16 @@ void EventDetector::update(double t, const std::vector<ParamValue>& params, std:
         tr.started = true;
         tr.scale = std::max(std::abs(p.value), 1e-12);
       }
-      const auto c = tr.ph.update(p.value / tr.scale);
+      tr.recent[tr.n_recent++ % tr.recent.size()] = p.value;
+      std::array<double, 5> m = tr.recent;
+      const std::size_t k = std::min(tr.n_recent, m.size());
+      std::nth_element(m.begin(), m.begin() + static_cast<std::ptrdiff_t>(k / 2), m.begin() + static_cast<std::ptrdiff_t>(k));
+      const auto c = tr.ph.update(m[k / 2] / tr.scale);
       if (c != PageHinkley::Change::none) {
         out.push_back({t, "drift", p.name, tr.ph.mean_before(c) * tr.scale, p.value});
         tr.ph.reset();
         tr.scale = std::max(std::abs(p.value), 1e-12);
+        tr.n_recent = 0;
       }
     }
     tr.last = p.value;

@@ -114,6 +114,8 @@ class Pipeline {
     ++counts_.frames;
     const double v_before = map_.v(), y_before = map_.y();
     bool is_y = false, jump = false;
+    // after a silence the counters start over (the first frame is not a jump)
+    if (have_frame_ && f.timestamp_s - last_frame_ts_ > s_.stale_timeout_s) map_.forget_counters();
     const FrameCheck c = map_.decode(f, is_y, jump);
     switch (c) {
       case FrameCheck::other: ++counts_.other; return true;

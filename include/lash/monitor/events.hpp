@@ -6,10 +6,13 @@
 ///    Edge-triggered: one event on leaving, re-armed on coming back inside.
 ///  - `drift`: the Page–Hinkley test (lash/metrics/page_hinkley.hpp) on the period-by-period
 ///    values of every identified parameter, relative to its value when the warm-up ended
-///    (x / |x_ref|, so δ and h are fractions): settings in `[drift]` (`delta`, `threshold`,
+///    (x / |x_ref|, so δ and h are fractions), fed the running median of the last 5 identified
+///    values (a one- or two-period excursion of an estimate, e.g. when the switching-guess
+///    search moves, is not a change): settings in `[drift]` (`delta`, `threshold`,
 ///    `warmup_s`, `enabled`, `parameters`). `before` is the mean up to the estimated change, `after` the
 ///    value at the alarm; the test restarts after each alarm.
 /// Not real-time code (runs once per period).
+#include <array>
 #include <map>
 #include <string>
 #include <vector>
@@ -80,6 +83,8 @@ class EventDetector {
     PageHinkley ph;
     bool outside = false;
     double last = std::numeric_limits<double>::quiet_NaN();
+    std::array<double, 5> recent{};  ///< the last identified values (ring), for the running median
+    std::size_t n_recent = 0;
   };
   AlarmSettings s_;
   std::map<std::string, Track> tracks_;
