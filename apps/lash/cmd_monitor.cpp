@@ -151,7 +151,9 @@ Command add_monitor(CLI::App& app) {
   sub->add_option("--every", s.every_s, "Period of the estimates [s of frame time] (default 1)");
   sub->add_option("--dt", s.dt_s, "Resample at this fixed period, zero-order hold [s] (default: one sample per y frame)");
   sub->add_option("--stale-timeout", s.stale_timeout_s, "No watched frame for this long = stale [s] (default 0.5)");
-  sub->add_option("--window", s.window_s, "Estimate over the last S seconds only (default 0: every sample)");
+  sub->add_option("--window", s.window_s,
+                  "Each estimate covers the samples of the last S seconds; memory and cost per period bounded "
+                  "(default 120; 0: every sample since the start, unbounded)");
   sub->add_option("--record", s.record_csv, "Write the t,v,y samples exactly as fed to the estimator (CSV)");
   sub->add_option("--jsonl", s.jsonl, "One JSON object per period and per event; - = stdout");
   sub->add_option("--db", s.db, "SQLite history (WAL, one transaction per period)");

@@ -169,7 +169,7 @@ class Pipeline {
     if (have_pending_ && s_.dt_s <= 0 && std::isfinite(map_.v()) && !stopped_)
       sample(pending_t_, map_.v(), pending_y_, cb);  // the last y with the latest v
     have_pending_ = false;
-    if (!t_.empty() && (t_.size() != last_snapshot_n_ || !pending_events_.empty()))
+    if (!t_.empty() && (counts_.samples != last_snapshot_total_ || !pending_events_.empty()))
       snapshot(t_.back(), "final", cb);
     if (record_.is_open()) record_.flush();
     if (db_) {
@@ -216,6 +216,7 @@ class Pipeline {
     if (!have_t0_) {
       have_t0_ = true;
       t0_ = ts;
+      next_period_ = s_.every_s;  // periods end at k·every_s, k >= 1
       open_db(ts);
     }
     const double t = ts - t0_;
@@ -236,13 +237,15 @@ class Pipeline {
     y_.push_back(y);
     ++counts_.samples;
     if (record_.is_open()) record_ << format_double(t) << ',' << format_double(v) << ',' << format_double(y) << '\n';
+    // bounded memory: once the kept samples span 2 windows, those before the last window go
+    // (amortised O(1) per sample: each sample is moved at most once)
     if (s_.window_s > 0 && t - t_.front() > 2 * s_.window_s) trim(t - s_.window_s);
     return true;
   }
 
-  /// Drops the samples before `t_from` (window_s), keeping the restart rows aligned.
+  /// Drops the samples at or before `t_from` (window_s), keeping the restart rows aligned.
   void trim(double t_from) {
-    const auto n = static_cast<std::size_t>(std::lower_bound(t_.begin(), t_.end(), t_from) - t_.begin());
+    const auto n = static_cast<std::size_t>(std::upper_bound(t_.begin(), t_.end(), t_from) - t_.begin());
     t_.erase(t_.begin(), t_.begin() + static_cast<std::ptrdiff_t>(n));
     v_.erase(v_.begin(), v_.begin() + static_cast<std::ptrdiff_t>(n));
     y_.erase(y_.begin(), y_.begin() + static_cast<std::ptrdiff_t>(n));
@@ -250,24 +253,35 @@ class Pipeline {
     for (const std::size_t r : extra_gaps_)
       if (r > n) kept.push_back(r - n);
     extra_gaps_ = std::move(kept);
-    last_snapshot_n_ = 0;
+    trimmed_ += n;
   }
 
   void snapshot(double t, const std::string& status, const PeriodCallback& cb) {
     Period p;
     p.t = t;
     p.status = status;
-    // the samples up to t (the period's end); the final snapshot takes them all
+    // the samples up to t (the period's end; the final snapshot: the last sample's time) and,
+    // with a window S, after t - S: T - S < t_k <= T
     const auto n = static_cast<std::size_t>(std::upper_bound(t_.begin(), t_.end(), t) - t_.begin());
-    p.samples = n;
-    last_snapshot_n_ = n;
-    if (n >= 3) {
-      const std::span<const double> tt(t_.data(), n), vv(v_.data(), n), yy(y_.data(), n);
+    const std::size_t b =
+        s_.window_s > 0
+            ? static_cast<std::size_t>(std::upper_bound(t_.begin(), t_.begin() + static_cast<std::ptrdiff_t>(n),
+                                                        t - s_.window_s) - t_.begin())
+            : 0;
+    const std::size_t m = n - b;
+    p.samples = m;
+    last_snapshot_total_ = trimmed_ + n;
+    if (m >= 3) {
+      const std::span<const double> tt(t_.data() + b, m), vv(v_.data() + b, m), yy(y_.data() + b, m);
       Sampling smp = analyse_sampling(tt);
-      counts_.gaps = smp.gap_rows.size();
+      for (const std::size_t r : smp.gap_rows)  // gaps counted once over the run (windows overlap)
+        if (trimmed_ + b + r > last_gap_row_) {
+          ++counts_.gaps;
+          last_gap_row_ = trimmed_ + b + r;
+        }
       if (!extra_gaps_.empty()) {
         for (const std::size_t r : extra_gaps_)
-          if (r < n) smp.gap_rows.push_back(r);
+          if (r > b && r < n) smp.gap_rows.push_back(r - b);
         std::sort(smp.gap_rows.begin(), smp.gap_rows.end());
         smp.gap_rows.erase(std::unique(smp.gap_rows.begin(), smp.gap_rows.end()), smp.gap_rows.end());
       }
@@ -329,7 +343,9 @@ class Pipeline {
   double pending_t_ = 0.0, pending_y_ = 0.0;
   double t0_ = 0.0, last_frame_ts_ = 0.0, next_period_ = 0.0, grid_t0_ = 0.0;
   std::uint64_t grid_k_ = 0;
-  std::size_t last_snapshot_n_ = 0;
+  std::uint64_t last_snapshot_total_ = 0;  ///< samples of the run up to the last snapshot's end
+  std::uint64_t trimmed_ = 0;              ///< samples dropped from the front of t_, v_, y_
+  std::uint64_t last_gap_row_ = 0;         ///< run row of the last gap counted
 };
 
 SignalMap make_map(const MonitorSettings& s) {

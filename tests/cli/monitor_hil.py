@@ -4,7 +4,10 @@ One `lash hil run` of the valve drift scenario (right edge 288 -> 380 mA at 20 s
 no-drift scenario, then, on their master_bus.log:
  - the samples the monitor fed (--record) equal the log read by python-can and decoded by hand
    (little-endian 16-bit fields times the DBC factor), paired as the master pairs them;
- - the last JSON line of `lash monitor ... --jsonl -` equals `lash estimate rec.csv --json` byte for byte;
+ - the last JSON line of `lash monitor ... --jsonl -` equals `lash estimate rec.csv --json` byte for byte
+   (the run, 40 s, is shorter than the default 120 s window: the estimate covers every sample);
+   with --window 10 it equals `lash estimate` of the record's rows of the last 10 s, and every
+   period's sample count is the number of record rows in (T - 10, T];
  - a `drift` event on c_r between 20 and 25 s and no event before 20 s; none on the no-drift run;
  - the SQLite history (read with Python's sqlite3) passes integrity_check and holds one period
    per JSON estimate line; `kill -9` of a monitor writing a database leaves a database that
@@ -101,6 +104,28 @@ last = [line for line in r.stdout.splitlines() if '"event"' not in line][-1]
 assert last.startswith('{"t":')
 assert "{" + last.split(",", 1)[1] == e, (last[:200], e[:200])
 print("last JSON line == lash estimate rec.csv --json")
+
+# the sliding window (--window 10): each period's estimate covers the record's rows with
+# T - 10 < t <= T; the last line equals lash estimate of those rows (selected here from rec.csv)
+wdb, wrec = os.path.join(tmp, "w10.sqlite"), os.path.join(tmp, "w10.csv")
+r10 = monitor(log, "--window", "10", "--record", wrec, "--jsonl", "-", "--db", wdb)
+with open(wrec) as f:
+    wlines = f.read().splitlines()
+assert wlines[1:] == open(rec).read().splitlines()[1:], "the record holds every sample, window or not"
+wt = [float(x.split(",")[0]) for x in wlines[1:]]
+tail = os.path.join(tmp, "w10_tail.csv")
+with open(tail, "w") as f:
+    f.write("\n".join([wlines[0]] + [x for x, t in zip(wlines[1:], wt) if t > wt[-1] - 10.0]) + "\n")
+e10 = subprocess.run([LASH, "estimate", tail, *EST, "--json"], capture_output=True, text=True, check=True).stdout.strip()
+last10 = [line for line in r10.stdout.splitlines() if '"event"' not in line][-1]
+assert "{" + last10.split(",", 1)[1] == e10, (last10[:200], e10[:200])
+con = sqlite3.connect(wdb)
+per = con.execute("SELECT t, samples FROM periods").fetchall()
+con.close()
+for T, n in per:
+    assert n == sum(1 for t in wt if T - 10.0 < t <= T), (T, n)
+print(f"--window 10: last JSON line == lash estimate of the last 10 s of rec.csv; "
+      f"samples of {len(per)} periods = rows in (T-10, T]")
 
 # drift on the right edge between 20 and 25 s, nothing before 20 s
 assert all(ev["t"] >= 20 for ev in events), events

@@ -10,10 +10,10 @@
 /// Sampling: each frame of y's message is one sample (t = the frame's time, v = the latest v
 /// received before it), or with dt_s > 0 a zero-order hold at t0 + k·dt (v and y the latest
 /// values received at or before that instant). t is in seconds since the first sample.
-/// Each period's estimate is estimate_arrays over the samples so far (the last window_s
-/// seconds when window_s > 0), restarted at the record's timestamp gaps (as `lash estimate`)
+/// Each period's estimate is estimate_arrays over the samples of the last window_s seconds
+/// (default 120 s; 0 = every sample so far), restarted at the record's timestamp gaps (as `lash estimate`)
 /// and where a silence or an alive-counter jump was seen: the last one equals
-/// `lash estimate RECORD.csv --json` on the record of the same samples.
+/// `lash estimate RECORD.csv --json` on the rows of the record in the last window.
 /// One library call serves the CLI and Python. Not real-time code.
 #include <atomic>
 #include <cstdint>
@@ -38,7 +38,10 @@ struct MonitorSettings {
   double every_s = 1.0;            ///< period of the snapshots [s of frame time]
   double dt_s = 0.0;               ///< > 0: zero-order-hold resampling period [s]
   double stale_timeout_s = 0.5;    ///< no frame of a watched message for this long = stale [s]
-  double window_s = 0.0;           ///< > 0: estimate over the last window_s seconds only [s]
+  /// > 0: each period's estimate covers the samples of the last window_s seconds, T - window_s < t <= T
+  /// (T = the period's end), and the monitor keeps at most 2·window_s seconds of samples (bounded
+  /// memory and cost per period); 0: every sample since the start (memory and cost grow with the run) [s]
+  double window_s = 120.0;
   double duration_s = 0.0;         ///< > 0: stop after this long (frame time; live: also wall time) [s]
   bool realtime = false;           ///< a log at its recorded pace
   bool until_alarm = false;        ///< stop after the period with the first drift/threshold event
