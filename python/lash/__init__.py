@@ -20,13 +20,14 @@ from ._lash import (  # noqa: F401  (re-exported)
     Plant,
     Result,
     estimate,
+    monitor_log,
     read_record,
     signal,
 )
 from ._lash import _sweep_csv
 from . import can  # noqa: F401
 
-__all__ = ["BacklashInverse", "DeadzoneInverse", "Estimator", "InputError", "Plant", "Result", "estimate", "read_record", "signal", "sweep", "can"]
+__all__ = ["BacklashInverse", "DeadzoneInverse", "Estimator", "InputError", "Plant", "Result", "estimate", "monitor_log", "read_record", "signal", "sweep", "can"]
 __version__ = "0.1.0"
 
 InputError.__doc__ = (

@@ -73,5 +73,6 @@ void bind_plant(pyb::module_& m);
 void bind_can(pyb::module_& m);
 void bind_sweep(pyb::module_& m);
 void bind_compensate(pyb::module_& m);
+void bind_monitor(pyb::module_& m);
 
 }  // namespace lash::py

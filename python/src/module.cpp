@@ -10,4 +10,5 @@ PYBIND11_MODULE(_lash, m) {
   lash::py::bind_can(m);
   lash::py::bind_sweep(m);
   lash::py::bind_compensate(m);
+  lash::py::bind_monitor(m);
 }

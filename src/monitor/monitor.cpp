@@ -19,7 +19,10 @@
 namespace lash::monitor {
 
 void apply_monitor_config(const std::string& path, MonitorSettings& s) {
-  toml::table file = parse_toml_file(path);
+  apply_monitor_table(parse_toml_file(path), path, s);
+}
+
+void apply_monitor_table(const toml::table& file, const std::string& path, MonitorSettings& s) {
   TomlTable t(file, path);
   s.alarms = read_alarm_settings(t);
   auto keys = std::make_shared<toml::table>(file);

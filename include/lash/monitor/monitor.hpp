@@ -54,6 +54,8 @@ struct MonitorSettings {
 /// every other key as `lash estimate --config` reads them (`model` and `preset` when the
 /// command line gave none). InputError naming file, line and key.
 void apply_monitor_config(const std::string& path, MonitorSettings& s);
+/// The same from a table already read (`name` stands for the file in messages): Python's keywords.
+void apply_monitor_table(const toml::table& file, const std::string& name, MonitorSettings& s);
 
 /// Checks the settings without reading the source: expressions against the DBC, the
 /// estimator settings, the numbers. InputError (exit 2) naming the option, file or signal.
