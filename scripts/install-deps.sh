@@ -9,9 +9,9 @@ packages=(
   build-essential cmake ninja-build g++ clang pkg-config
   # libraries
   libeigen3-dev libcli11-dev libfmt-dev libtomlplusplus-dev nlohmann-json3-dev
-  libmatio-dev zlib1g-dev
+  libmatio-dev zlib1g-dev libsqlite3-dev
   # tests and benchmarks
-  libgtest-dev libgmock-dev libbenchmark-dev gnuplot-nox valgrind
+  libgtest-dev libgmock-dev libbenchmark-dev gnuplot-nox valgrind sqlite3
   rt-tests  # cyclictest, the peer of bench/latency_vs_cyclictest.py
   iproute2 util-linux
   # python oracles (Debian's /usr/bin/python3)

@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
         add_can(app),
         add_hil(app),
         add_xcp(app),
+        add_monitor(app),
     };
     try {
       app.parse(argc, argv);

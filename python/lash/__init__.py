@@ -20,6 +20,7 @@ from ._lash import (  # noqa: F401  (re-exported)
     Plant,
     Result,
     estimate,
+    monitor_log,
     read_record,
     signal,
 )
@@ -27,7 +28,7 @@ from ._lash import _sweep_csv
 from . import can  # noqa: F401
 from . import xcp  # noqa: F401
 
-__all__ = ["BacklashInverse", "DeadzoneInverse", "Estimator", "InputError", "Plant", "Result", "estimate", "read_record", "signal", "sweep", "can", "xcp"]
+__all__ = ["BacklashInverse", "DeadzoneInverse", "Estimator", "InputError", "Plant", "Result", "estimate", "monitor_log", "read_record", "signal", "sweep", "can", "xcp"]
 __version__ = "0.1.0"
 
 InputError.__doc__ = (

@@ -1,6 +1,6 @@
 from ._lash import (BacklashInverse as BacklashInverse, DeadzoneInverse as DeadzoneInverse,
                     Estimator as Estimator, InputError as InputError, Plant as Plant, Result as Result,
-                    estimate as estimate, read_record as read_record, signal as signal)
+                    estimate as estimate, monitor_log as monitor_log, read_record as read_record, signal as signal)
 from . import can as can
 from . import xcp as xcp
 

@@ -90,6 +90,12 @@ def signal(kind: str, duration_s: float, dt_s: float, *, amplitude: float = 1.0,
            steps: Iterable[tuple[float, float]] = ()) -> npt.NDArray[np.float64]:
     """round(duration_s/dt_s) samples of an excitation (sine | square | triangle | randomized | steps | constant)."""
 
+def monitor_log(path: str, dbc: str, v: str, y: str, *, model: str = "deadzone-deadband", preset: str = "lash",
+                every: float = 1.0, dt: float = 0.0, window: float = 120.0, stale_timeout: float = 0.5,
+                record: str = "", db: str = "", jsonl: str = "", **settings: Any) -> dict[str, Any]:
+    """`lash monitor LOGFILE` as a call: the history, one entry per period (t, samples, status, each
+    parameter with <param>_lo/_hi, NaN while not identified), events (dict of columns), counts, last."""
+
 def read_record(path: str, columns: Sequence[str] = ("t", "v", "y")) -> dict[str, Any]:
     """t [s], v, y arrays, dt_s [s] and file of a CSV or MAT record."""
 

@@ -74,5 +74,6 @@ void bind_can(pyb::module_& m);
 void bind_sweep(pyb::module_& m);
 void bind_compensate(pyb::module_& m);
 void bind_xcp(pyb::module_& m);
+void bind_monitor(pyb::module_& m);
 
 }  // namespace lash::py

@@ -11,4 +11,5 @@ PYBIND11_MODULE(_lash, m) {
   lash::py::bind_sweep(m);
   lash::py::bind_compensate(m);
   lash::py::bind_xcp(m);
+  lash::py::bind_monitor(m);
 }
