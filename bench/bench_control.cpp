@@ -1,5 +1,5 @@
 // Control: one sample of the master's controller (PID → deadzone inverse → saturation),
-// one sample of the SPEC B1 plant (measure + apply), one discrete closed-loop step test and
+// one sample of the plant of docs/method.md §B1 (measure + apply), one discrete closed-loop step test and
 // one ode3 step test (2 s at 5 ms = 400 samples). See docs/control.md.
 #include <benchmark/benchmark.h>
 

@@ -1,4 +1,4 @@
-// Estimator throughput: one (v, y) sample per step() (SPEC A4; goal: deadzone-deadband >= 50 M samples/s).
+// Estimator throughput: one (v, y) sample per step() (docs/method.md §A4; goal: deadzone-deadband >= 50 M samples/s).
 // Data: the E1 plant (thesis eq. 34), v = 600 sin(t), precomputed so only the estimator is timed.
 #include <benchmark/benchmark.h>
 

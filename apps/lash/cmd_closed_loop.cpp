@@ -1,5 +1,5 @@
-// lash closed-loop: the SPEC B2 closed loop (PID + deadzone inverse + saturation around the
-// SPEC B1 pilot valve) simulated (a) discretely and (b) continuously with ode3; step metrics of both.
+// lash closed-loop: the closed loop of docs/method.md §B2 (PID + deadzone inverse + saturation around the
+// pilot valve of §B1) simulated (a) discretely and (b) continuously with ode3; step metrics of both.
 #include <cmath>
 #include <utility>
 
@@ -147,7 +147,7 @@ int run(const Options& o) {
 Command add_closed_loop(CLI::App& app) {
   auto o = std::make_shared<Options>();
   auto* sub = app.add_subcommand(
-      "closed-loop", "Step response of the pilot-valve closed loop: discrete solver vs continuous ode3 (SPEC B2)");
+      "closed-loop", "Step response of the pilot-valve closed loop: discrete solver vs continuous ode3 (docs/method.md §B2)");
   sub->add_option("--gains", o->gains, "Controller TOML (default config/control/thesis_gains.toml)");
   sub->add_option("--r0", o->r0, "Reference before the step [kPa]");
   sub->add_option("--r1", o->r1, "Reference after the step [kPa]");

@@ -19,7 +19,7 @@ double param(const SideParams& p, int i) { return i == 0 ? p.a1 : i == 1 ? p.b1 
 
 std::string pct(double x) { return std::isfinite(x) ? fmt::format("{:.4f}", x) : std::string("n/a"); }
 
-/// E1 / E2 (SPEC A7): parameter, truth, estimate, error % (seed 1), worst error % over all seeds.
+/// E1 / E2 (docs/method.md §A7): parameter, truth, estimate, error % (seed 1), worst error % over all seeds.
 void identification_tables(const std::string& dir) {
   for (const char* file : {"e1.toml", "e2.toml"}) {
     const ScenarioSpec s = load_scenario(dir + "/" + file);

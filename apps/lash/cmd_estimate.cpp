@@ -1,4 +1,4 @@
-// lash estimate: run one of the switching estimators of SPEC A4 over a recorded t,v,y file.
+// lash estimate: run one of the switching estimators of docs/method.md §A4 over a recorded t,v,y file.
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -103,7 +103,7 @@ int run(const CLI::App& sub, const EstimateOptions& o) {
 
 Command add_estimate(CLI::App& app) {
   auto o = std::make_shared<EstimateOptions>();
-  auto* sub = app.add_subcommand("estimate", "Identify a model online (switching RLS, SPEC A4) from a t,v,y record");
+  auto* sub = app.add_subcommand("estimate", "Identify a model online (switching RLS, docs/method.md §A4) from a t,v,y record");
   sub->add_option("data", o->data, "Record with a header line and columns t, v, y (CSV)")->required();
   sub->add_option("--model", o->model,
                   "linear | input-deadzone | output-deadzone | deadzone-deadband | coupled-carts");

@@ -1,4 +1,4 @@
-// lash hil: real-time HIL emulation of the hydraulic bench (thesis paper 2, SPEC B).
+// lash hil: real-time HIL emulation of the hydraulic bench (thesis paper 2, docs/method.md §B).
 //   lash hil slave    — slave ECU + pilot-valve plant emulator on a bus
 //   lash hil master   — master ECU (CCP connect, PID + deadzone inverse + saturation)
 //   lash hil latency  — the periodic loop alone
@@ -110,7 +110,7 @@ hil::LoopOptions loop_options(const CommonOptions& o, const hil::BenchSettings& 
 namespace lash::cli {
 
 Command add_hil(CLI::App& app) {
-  auto* hil = app.add_subcommand("hil", "Real-time HIL emulation of the hydraulic bench over CAN (SPEC B)");
+  auto* hil = app.add_subcommand("hil", "Real-time HIL emulation of the hydraulic bench over CAN (docs/method.md §B)");
   hil->require_subcommand(1);
   auto nodes = std::make_shared<std::function<int()>>();
   auto run = std::make_shared<std::function<int()>>();

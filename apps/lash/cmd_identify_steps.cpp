@@ -1,4 +1,4 @@
-// lash identify-steps: SPEC B6 offline step-test fit (bias, deadzone, gain, τ, σ) of open-loop
+// lash identify-steps: the offline step-test fit of docs/method.md §B6 (bias, deadzone, gain, τ, σ) of open-loop
 // stepped-current pilot-valve data.
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
@@ -90,7 +90,7 @@ int run(const Options& o) {
 Command add_identify_steps(CLI::App& app) {
   auto o = std::make_shared<Options>();
   auto* sub = app.add_subcommand("identify-steps",
-                                 "Fit bias, deadzone, gain, time constant and noise to stepped-current data (SPEC B6)");
+                                 "Fit bias, deadzone, gain, time constant and noise to stepped-current data (docs/method.md §B6)");
   sub->add_option("data", o->data, "CSV with time, current and pressure columns")->required();
   sub->add_option("--time-column", o->t_col, "Time column [s]");
   sub->add_option("--current-column", o->i_col, "Current column [mA]");

@@ -1,4 +1,4 @@
-// lash sweep: run a campaign of virtual-rig runs (SPEC A7, E3–E5) in parallel and report NRMSE.
+// lash sweep: run a campaign of virtual-rig runs (docs/method.md §A7, E3–E5) in parallel and report NRMSE.
 #include <unistd.h>
 
 #include <algorithm>

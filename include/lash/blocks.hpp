@@ -1,6 +1,6 @@
 #pragma once
 /// @file blocks.hpp
-/// All discrete-time blocks of SPEC A1. Each is a small value type with a
+/// All discrete-time blocks of docs/method.md §A1. Each is a small value type with a
 /// `noexcept`, allocation-free, O(1) `step()`; configuration is checked in the
 /// constructor (std::invalid_argument).
 #include "lash/blocks/backlash_inverse.hpp"

@@ -74,7 +74,7 @@ class Estimator:
         """Current parameters by name (a1_r, b1_r, c_r, d_r, ...; NaN = not identified)."""
 
 class Plant:
-    """A chain of blocks (SPEC A1), from [[blocks]] tables (docs/plant-files.md) or a plant file."""
+    """A chain of blocks (docs/method.md §A1), from [[blocks]] tables (docs/plant-files.md) or a plant file."""
     def __init__(self, *, blocks: Sequence[Mapping[str, Any]], dt_s: float = 0.005) -> None: ...
     @staticmethod
     def from_toml(path: str, dt_s: float | None = None) -> Plant: ...

@@ -215,7 +215,7 @@ void bind_estimate(pyb::module_& m) {
         "         intervals=True, **settings) -> Result\n\n"
         "As `lash estimate`: preset 'lash' (settings tuned to the data, guesses searched when not given) or\n"
         "'thesis'; outlier_gate: isolated outliers of y beyond this many innovation scales are replaced (0 = off).\n"
-        "Runs one of lash's switching estimators (SPEC A4) over a whole record, as `lash estimate` does.\n"
+        "Runs one of lash's switching estimators (docs/method.md §A4) over a whole record, as `lash estimate` does.\n"
         "t [s] (strictly increasing, >= 3 samples; dt = mean step), v [input unit], y [output unit]: 1-D arrays\n"
         "of equal length (converted to contiguous float64 if needed). NaN samples of v or y are skipped and\n"
         "counted (Result.skipped). settings: the keys of an estimator config file (docs/identification.md),\n"

@@ -78,7 +78,7 @@ pyb::array_t<double> signal(const std::string& kind, double duration_s, double d
 
 void bind_plant(pyb::module_& m) {
   pyb::class_<PyPlant>(m, "Plant",
-                       "A chain of blocks (SPEC A1): Plant(blocks=[{'kind': 'deadzone', ...}, ...], dt_s=0.005)\n"
+                       "A chain of blocks (docs/method.md §A1): Plant(blocks=[{'kind': 'deadzone', ...}, ...], dt_s=0.005)\n"
                        "with the [[blocks]] tables of a plant file (docs/plant-files.md), or Plant.from_toml(path).")
       .def(pyb::init(&PyPlant::from_blocks), pyb::kw_only(), pyb::arg("blocks"), pyb::arg("dt_s") = 0.005)
       .def_static("from_toml", &PyPlant::from_toml, pyb::arg("path"), pyb::arg("dt_s") = pyb::none(),
@@ -96,7 +96,7 @@ void bind_plant(pyb::module_& m) {
         pyb::arg("phase_rad") = 0.0, pyb::arg("variance") = 10000.0, pyb::arg("tau_s") = 0.5, pyb::arg("seed") = 1,
         pyb::arg("steps") = std::vector<std::pair<double, double>>{},
         "signal(kind, duration_s, dt_s, **params) -> ndarray\n\n"
-        "An excitation of `lash simulate` (SPEC A2): kind sine | square | triangle | randomized | steps | constant;\n"
+        "An excitation of `lash simulate` (docs/method.md §A2): kind sine | square | triangle | randomized | steps | constant;\n"
         "round(duration_s/dt_s) samples at t_k = k*dt_s. amplitude [input unit], frequency_rad_s [rad/s],\n"
         "offset [input unit], phase_rad [rad], variance [unit^2] and tau_s [s] (randomized), seed,\n"
         "steps = [(t_s, value), ...] (steps).");

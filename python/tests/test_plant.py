@@ -48,7 +48,7 @@ def test_plant_from_blocks_equals_file():
     ya, yb = a.simulate(v), b.simulate(v)
     for k in ya:
         assert ya[k].tobytes() == yb[k].tobytes(), k
-    # the deadzone really acts: |v| inside it gives no motion (hand check of SPEC A1)
+    # the deadzone really acts: |v| inside it gives no motion (hand check of docs/method.md §A1)
     assert np.all(ya["x1_deadzone"][(v > -300) & (v < 200)] == 0.0)
 
 

@@ -113,6 +113,7 @@ DataTraits analyse_record(std::span<const double> v, std::span<const double> y, 
   return d;
 }
 
+// E3, E4 below: the thesis's experiments, defined in docs/method.md §A7.
 void tune_to_data(EstimatorConfig& c, const DataTraits& d) {
   c.dt_s = d.dt_s > 0.0 ? d.dt_s : c.dt_s;
   switch (c.model) {

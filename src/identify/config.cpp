@@ -112,7 +112,8 @@ EstimatorConfig::EstimatorConfig(ModelKind m, double dt) {
   model = m;
   dt_s = dt;
   // lash's data-independent settings per model (docs/identification.md "Defaults chosen from the
-  // data"); the settings that depend on the record come on top (tune_to_data, auto.hpp)
+  // data"); the settings that depend on the record come on top (tune_to_data, auto.hpp).
+  // E1–E5 below are the thesis's experiments, defined in docs/method.md §A7.
   switch (m) {
     case ModelKind::deadzone_deadband:
       // E2's method (docs/identification.md "E2: what got how far"): consistent MA40 on v and y,

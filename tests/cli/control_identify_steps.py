@@ -1,6 +1,6 @@
 """`lash identify-steps` on stepped-current data generated here with numpy (an implementation
 independent of lash's): input deadzone, exact ZOH first-order lag, bias, Gaussian noise and the
-SPEC B1 uint16 duty-cycle sensor code. Every parameter must come back within 3 %, for the
+uint16 duty-cycle sensor code of docs/method.md §B1. Every parameter must come back within 3 %, for the
 thesis's values and for others. Bad input exits 2 naming the file/column."""
 import json, os, shutil, subprocess, sys, tempfile
 import numpy as np

@@ -1,4 +1,4 @@
-"""The master runs unchanged against another implementation of the slave (SPEC B5,
+"""The master runs unchanged against another implementation of the slave (docs/method.md §B5,
 thesis §2.7.4): a python-can (Debian python3-can, udp_multicast interface) node that
 speaks config/hydraulic_bench.dbc through canmatrix — it answers the CCP CONNECT with the
 recorded DTO read by python-can's CanutilsLogReader and sends sensor frames from its own
@@ -110,7 +110,7 @@ def slave():
                     stats["commands"] += 1
             p = plant.step(current)
             duty = p / 48.82 + 5.98
-            raw = min(max(round(duty * 65535 / 100), 0), 65535)  # SPEC B1 sensor code
+            raw = min(max(round(duty * 65535 / 100), 0), 65535)  # sensor code, docs/method.md §B1
             # canmatrix's Frame.encode takes raw signal values and does the bit packing.
             data = bytearray(SEN.encode({"PilotPressure_Duty": raw, "SupplyPressure_Duty": 0,
                                          "Sensor_Counter": counter % 65536, "Sensor_CRC": 0}))

@@ -1,4 +1,4 @@
-// PID, deadzone inverse, controller chain and the SPEC B1 pilot-valve model.
+// PID, deadzone inverse, controller chain and the pilot-valve model of docs/method.md §B1.
 // Expected numbers are hand computations (shown inline) or Python's round().
 #include <cmath>
 #include <limits>

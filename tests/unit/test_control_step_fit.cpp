@@ -1,4 +1,4 @@
-// SPEC B6 step-test fit: recovers the parameters of the pilot-valve model that generated the data.
+// Step-test fit (docs/method.md §B6): recovers the parameters of the pilot-valve model that generated the data.
 #include <cmath>
 #include <cstdio>
 

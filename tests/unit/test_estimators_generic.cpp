@@ -1,5 +1,5 @@
 // One generic tester (in the manner of manif's invariant tester) run over all five estimators of
-// SPEC A4: every invariant of the sample path, on the same data, for every estimator type.
+// docs/method.md §A4: every invariant of the sample path, on the same data, for every estimator type.
 // This binary replaces the global operator new to count heap allocations inside update().
 #include <gtest/gtest.h>
 

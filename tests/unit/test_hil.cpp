@@ -76,7 +76,7 @@ TEST(HilLayout, CommandBytesByHand) {
 
 TEST(HilLayout, SensorBytesAndSpecScaling) {
   BenchLayout L;
-  // SPEC B1: 1000 kPa → duty 1000/48.82 + 5.98 = 26.46332… % → raw round(26.46332…·655.35) = 17343.
+  // docs/method.md §B1: 1000 kPa → duty 1000/48.82 + 5.98 = 26.46332… % → raw round(26.46332…·655.35) = 17343.
   const std::uint16_t raw = encode_pressure_raw(1000.0);
   EXPECT_EQ(raw, 17343);
   SensorMsg s{raw, 0, 513};

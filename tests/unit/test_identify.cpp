@@ -1,4 +1,4 @@
-// Identification (SPEC A3–A5): RLS, the switching estimators, E1.
+// Identification (docs/method.md §A3–§A5): RLS, the switching estimators, E1.
 // Reference numbers come from the plant parameters that generated the data (the estimator
 // never sees them) and from hand-checked identities; statsmodels agreement is a script test.
 #include <gtest/gtest.h>

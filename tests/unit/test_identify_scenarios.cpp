@@ -1,4 +1,4 @@
-// E1 and E2 (SPEC A7) run from the shipped scenario files; truth = the plant file's parameters.
+// E1 and E2 (docs/method.md §A7) run from the shipped scenario files; truth = the plant file's parameters.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -148,7 +148,7 @@ TEST(PilotValveRig, SteadyStateIsDeadzoneTimesGain) {
   EXPECT_NEAR(rig.bias_estimate_kPa(), 90.1, p.quantum_kPa);
   double y = 0;
   for (int k = 0; k < 1000; ++k) y = rig.step(1000.0);
-  // SPEC B1: 2.15 kPa/mA beyond 288 mA.
+  // docs/method.md §B1: 2.15 kPa/mA beyond 288 mA.
   EXPECT_NEAR(rig.true_pressure_kPa(), 2.15 * (1000.0 - 288.0), 1e-6);
   EXPECT_NEAR(y, 2.15 * 712.0, p.quantum_kPa);
   for (int k = 0; k < 1000; ++k) y = rig.step(-1000.0);

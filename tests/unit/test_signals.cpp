@@ -1,4 +1,4 @@
-// Signals of SPEC A2 against their formulas and the statistics theory predicts.
+// Signals of docs/method.md §A2 against their formulas and the statistics theory predicts.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -2,7 +2,7 @@
 /// @file side.hpp
 /// Which side of a piecewise block acts: chosen by the sign of the plant
 /// input of the previous sample, v(k−1) ≥ 0 → right, v(k−1) < 0 → left
-/// (SPEC A1, thesis eq. 34).
+/// (docs/method.md §A1.3, thesis eq. 34).
 #include <cstdint>
 
 namespace lash {

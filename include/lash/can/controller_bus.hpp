@@ -15,7 +15,7 @@
 /// The periodic loop times pull()+flush() as I/O and the task alone as TET (docs/hil.md).
 ///
 /// FIFO overflow: a full RX FIFO drops its oldest frame for the new one (the task wants the
-/// newest data; the loss is counted and the sequence counters of SPEC B3 see it); a full TX
+/// newest data; the loss is counted and the sequence counters of docs/method.md §B3 see it); a full TX
 /// FIFO refuses the frame (send() returns false). Both are counted.
 #include <cstddef>
 #include <cstdint>

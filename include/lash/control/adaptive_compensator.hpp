@@ -1,6 +1,6 @@
 #pragma once
 /// @file adaptive_compensator.hpp
-/// Adaptive inverses: an online estimator of SPEC A4 runs inside the controller at the sample
+/// Adaptive inverses: an online estimator of docs/method.md §A4 runs inside the controller at the sample
 /// rate on closed-loop data, and its parameters reach the inverse only through safeguards
 /// (docs/compensation.md):
 ///  - **verdict**: a side's estimate is used only while the estimator's verdict says that side

@@ -1,6 +1,6 @@
 #pragma once
 /// @file closed_loop.hpp
-/// Closed-loop simulation of SPEC B2 / thesis Fig 2.13 in the two ways the
+/// Closed-loop simulation of docs/method.md §B2 / thesis Fig 2.13 in the two ways the
 /// thesis compared (paper 2, §2.7.2):
 /// (a) **discrete**: what runs on the target: the discrete controller
 ///     (ClosedLoopDiscrete: discrete PID → deadzone inverse → saturation) and

@@ -1,6 +1,6 @@
 #pragma once
 /// @file controller.hpp
-/// The master-side controller of SPEC B2 / thesis Fig 2.12 as one step
+/// The master-side controller of docs/method.md §B2 / thesis Fig 2.12 as one step
 /// function: discrete PID → deadzone inverse → saturation 0–2000 mA.
 /// This is the exact code the closed-loop simulation (closed_loop.hpp) and the
 /// HIL master node call each sample, so emulation and simulation agree bit for bit.

@@ -1,6 +1,6 @@
 #pragma once
 /// @file campaign.hpp
-/// A campaign: the thesis's matrix of runs on one virtual rig (SPEC A7, E3–E5)
+/// A campaign: the thesis's matrix of runs on one virtual rig (docs/method.md §A7, E3–E5)
 /// with the estimator settings, read from a TOML file (docs/sweep.md).
 /// Not real-time safe.
 #include <cstdint>

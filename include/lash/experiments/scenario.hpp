@@ -1,6 +1,6 @@
 #pragma once
 /// @file scenario.hpp
-/// Named identification scenarios (SPEC A7: E1, E2): a plant file, an input, measurement
+/// Named identification scenarios (docs/method.md §A7: E1, E2): a plant file, an input, measurement
 /// noise, seeds, estimator settings and the true parameters. Files live in config/scenarios/.
 /// Not real-time safe.
 #include <cstdint>

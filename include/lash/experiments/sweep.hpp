@@ -1,9 +1,9 @@
 #pragma once
 /// @file sweep.hpp
-/// Runs a campaign (SPEC A7, E3–E5): every run drives its virtual rig with its
+/// Runs a campaign (docs/method.md §A7, E3–E5): every run drives its virtual rig with its
 /// signal, feeds (v, y) sample by sample to the estimator and scores the
 /// estimator's free-run simulated output against the rig's measured output by
-/// NRMSE = RMS(y − y_sim)/max|y| over the campaign's window (SPEC A6, thesis
+/// NRMSE = RMS(y − y_sim)/max|y| over the campaign's window (docs/method.md §A6, thesis
 /// 7.5–30 s). Runs are independent and run in parallel on a std::thread pool.
 /// Not real-time safe (this is the offline harness around real-time pieces).
 #include <cstdint>

@@ -1,7 +1,7 @@
 #pragma once
 /// @file bench_layout.hpp
 /// Where the hydraulic bench's signals sit in its CAN frames, read once from
-/// config/hydraulic_bench.dbc (SPEC B3, thesis paper 2 §2.7.3 Figs 2.17–2.18),
+/// config/hydraulic_bench.dbc (docs/method.md §B3, thesis paper 2 §2.7.3 Figs 2.17–2.18),
 /// and the real-time pack/unpack of those frames.
 ///
 ///   BenchCommand (master → slave): SolenoidA_Current, SolenoidB_Current,
@@ -12,7 +12,7 @@
 ///   CCP_CRO / CCP_DTO: the CONNECT handshake, can::ccp::Layout (can/ccp.hpp),
 ///                      which BenchLayout extends.
 ///
-/// The pilot pressure travels as the SPEC B1 sensor code
+/// The pilot pressure travels as the sensor code of docs/method.md §B1
 /// raw = round((p/48.82 + 5.98)·(2¹⁶ − 1)/100); both ends convert with
 /// lash::encode_pressure_raw / decode_pressure_raw (rigs/pilot_valve_model.hpp).
 /// Currents are raw = round(mA / factor) with the DBC factor (0.1 mA),

@@ -83,7 +83,7 @@ struct E2EConfig {
   double ramp_mA_per_s = 4000.0;         ///< degraded: the current ramps to 0 mA at this rate [mA/s]
 };
 
-/// Alive-counter continuity and the receive statistics of one cyclic message (SPEC B3).
+/// Alive-counter continuity and the receive statistics of one cyclic message (docs/method.md §B3).
 /// received: frames with the message's identifier (any content); late: accepted frames that
 /// arrived after the step that should have used them (more than one accepted frame in one
 /// step); lost: counter values skipped between accepted frames; resyncs: re-synchronisations

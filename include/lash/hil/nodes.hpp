@@ -1,13 +1,13 @@
 #pragma once
 /// @file nodes.hpp
-/// The two ECUs of the hydraulic bench (SPEC B, thesis paper 2 §2.7.3):
+/// The two ECUs of the hydraulic bench (docs/method.md §B, thesis paper 2 §2.7.3):
 ///
 /// - SlaveNode ("Slave and Plant Emulator", Figs 2.17–2.19): answers the master's CCP
 ///   CONNECT by replaying a recorded DTO (it does not interpret it); each step it
-///   reads the newest current command, steps the pilot-valve plant of SPEC B1 and
+///   reads the newest current command, steps the pilot-valve plant of docs/method.md §B1 and
 ///   sends the sensor frame (supply pressure sent as 0).
 /// - MasterNode ("Master Emulator", Fig 2.16): sends CRO until a DTO arrives, then
-///   each step runs the SPEC B2 controller (discrete PID → deadzone inverse →
+///   each step runs the controller of docs/method.md §B2 (discrete PID → deadzone inverse →
 ///   saturation 0–2000 mA) on the newest sensor frame and sends the command frame.
 ///
 /// Both check every frame they receive before acting on it (hil/e2e.hpp: DLC, CRC-8 SAE
@@ -178,7 +178,7 @@ struct CompensationState {
 // ----------------------------------------------------------------------------- slave
 
 struct SlaveConfig {
-  PilotValveParams plant;                 ///< SPEC B1 (dt_s = the step)
+  PilotValveParams plant;                 ///< docs/method.md §B1 (dt_s = the step)
   std::vector<can::Frame> dto_reply;      ///< the recorded DTO frame(s), replayed on every CONNECT
   std::size_t log_capacity = 0;           ///< steps logged (preallocated)
   E2EConfig e2e;                          ///< plausibility, recovery and ramp settings
@@ -246,7 +246,7 @@ class SlaveNode {
 // ----------------------------------------------------------------------------- master
 
 struct MasterConfig {
-  ControllerConfig controller;             ///< SPEC B2; controller.pid.dt_s = the step
+  ControllerConfig controller;             ///< docs/method.md §B2; controller.pid.dt_s = the step
   SignalSpec reference;                    ///< r(m), m = steps since the first CONNECT reply [kPa]
   double dto_timeout_s = 2.0;              ///< no DTO by then → failed (clear error)
   std::uint32_t fault_missed_periods = 3;  ///< steps without a plausible sensor frame → safe (0 mA)

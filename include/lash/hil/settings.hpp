@@ -1,7 +1,7 @@
 #pragma once
 /// @file settings.hpp
 /// Node settings of the bench (config/hil/bench.toml): DBC, recorded CCP reply,
-/// bus address, step, plant (SPEC B1) and controller (SPEC B2) parameters, master
+/// bus address, step, plant (docs/method.md §B1) and controller (docs/method.md §B2) parameters, master
 /// fault handling; and the `KIND:key=value,…` reference syntax. Not real-time safe.
 #include <filesystem>
 #include <optional>

@@ -1,6 +1,6 @@
 #pragma once
 /// @file any_estimator.hpp
-/// One type for every estimator of SPEC A4 (a std::variant, no virtual calls), plus a
+/// One type for every estimator of docs/method.md §A4 (a std::variant, no virtual calls), plus a
 /// summary report and a batch runner used by `lash estimate`, `lash demo` and sweeps.
 #include <algorithm>
 #include <functional>

@@ -1,6 +1,6 @@
 #pragma once
 /// @file config.hpp
-/// Settings shared by every estimator of SPEC A4/A5 (docs/identification.md).
+/// Settings shared by every estimator of docs/method.md §A4/§A5 (docs/identification.md).
 /// Plain structs; `validate()` is called once at construction and throws
 /// std::invalid_argument naming the offending field (the CLI turns that into exit 2).
 #include <array>
@@ -34,7 +34,7 @@ Forgetting parse_forgetting(std::string_view name);
 const char* to_string(Forgetting f) noexcept;
 
 /// Settings of every RLS inside an estimator (thesis §1.5.1: λ = 0.99, P0 = 1000·I, η0 = [1 1 1]).
-/// Parameter order is [a1, b1, e] (SPEC A4); the linear model uses the first two.
+/// Parameter order is [a1, b1, e] (docs/method.md §A4); the linear model uses the first two.
 struct RlsSettings {
   double lambda = 0.99;
   double p0 = 1000.0;
@@ -83,7 +83,7 @@ struct DerivativeSwitchingSettings {
   void validate() const;
 };
 
-/// Noise handling of SPEC A5 / thesis §1.4.5. Defaults pass the signals through untouched.
+/// Noise handling of docs/method.md §A5 / thesis §1.4.5. Defaults pass the signals through untouched.
 /// One struct per model group underneath, so `cfg.noise.derivative_threshold` reads as before.
 struct NoiseSettings : RegressionFilterSettings, DerivativeSwitchingSettings {};
 
@@ -118,7 +118,7 @@ struct InputSwitchingSettings {
   double guess_left = -std::numeric_limits<double>::infinity();  ///< c_l* [v unit]; −inf = searched
   double guess_right = std::numeric_limits<double>::infinity();  ///< c_r* [v unit]; +inf = searched
   /// Free-run simulation inside the input deadzone: false = keep the a1 of the side last used
-  /// (thesis §1.4.2, SPEC A4); true = side by the sign of v(k−1) (eq. 34).
+  /// (thesis §1.4.2, docs/method.md §A4.2); true = side by the sign of v(k−1) (eq. 34).
   bool sim_side_by_sign = false;
   static constexpr ModelSet models =
       model_bit(ModelKind::input_deadzone) | model_bit(ModelKind::deadzone_deadband);

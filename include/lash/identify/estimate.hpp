@@ -21,7 +21,7 @@ namespace lash {
 struct EstimateResult {
   EstimateReport report;
   double dt_s = 0.0;        ///< sample period used by the estimator (mean step of t) [s]
-  double nrmse = 0.0;       ///< NRMSE of the free-run simulation over the window (SPEC A6); NaN if empty
+  double nrmse = 0.0;       ///< NRMSE of the free-run simulation over the window (docs/method.md §A6); NaN if empty
   double nrmse_t0_s = 0.0;  ///< window start [s]
   double nrmse_t1_s = 0.0;  ///< window end [s] (the last t when the job leaves it open)
 };

@@ -1,6 +1,6 @@
 #pragma once
 /// @file estimators.hpp
-/// The switching RLS estimators of SPEC A4 (thesis §1.4, §1.6). Each takes one sample
+/// The switching RLS estimators of docs/method.md §A4 (thesis §1.4, §1.6). Each takes one sample
 /// (v(k), y(k)) per step(), which is noexcept, O(1) and allocation-free; construction
 /// validates the EstimatorConfig (std::invalid_argument) and allocates the filters.
 ///
@@ -9,7 +9,7 @@
 /// y_sim of the identified model driven by v alone. A parameter that is not identified yet
 /// is NaN — never a huge number.
 ///
-/// Regression (SPEC A4): φ(k) = [−y(k−1), v(k−1), 1], η = [a1, b1, e].
+/// Regression (docs/method.md §A4): φ(k) = [−y(k−1), v(k−1), 1], η = [a1, b1, e].
 ///
 /// restart() (after a gap in the record's timestamps, docs/identification.md "Gaps") clears the
 /// signal history — filters, delays, derivative, the direction-hold counters, the previous samples
@@ -54,7 +54,7 @@ struct History {
   double ago(std::size_t j) const noexcept { return buf[(pos - static_cast<unsigned>(j)) & 63u]; }
 };
 /// The one free-run side choice of the two-sided models: right above the right edge, left below
-/// the left edge, otherwise (inside the deadzone) the side last used (thesis §1.4.2, SPEC A4);
+/// the left edge, otherwise (inside the deadzone) the side last used (thesis §1.4.2, docs/method.md §A4.2);
 /// by_sign: the side of the sign of x (eq. 34).
 constexpr Side free_run_side(double x, const PerSide<double>& edge, Side last, bool by_sign = false) noexcept {
   if (by_sign) return side_of(x);

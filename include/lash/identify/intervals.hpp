@@ -9,7 +9,7 @@
 /// standard deviation s and the memory m of the estimator (m = min(length, 1/(1 − λ)); λ = 1:
 /// the length), the standard error of the whole-record estimate θ is s·√(m_section / m_record)
 /// and the interval θ ± t_{0.975, B'−1} · SE (Student's t for the B' sections used).
-/// Why not σ²·P: with filtered v and y (the moving averages of SPEC A5) the equation error is
+/// Why not σ²·P: with filtered v and y (the moving averages of docs/method.md §A5) the equation error is
 /// correlated over the filter length, and with instrumental variables P is not a covariance;
 /// sections see both effects as they are. K and τ get their own section estimates (not a
 /// linearisation). An interval needs at least 5 identified sections; otherwise it is absent

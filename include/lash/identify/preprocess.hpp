@@ -1,6 +1,6 @@
 #pragma once
 /// @file preprocess.hpp
-/// Noise handling of SPEC A5 / thesis §1.4.5, one sample at a time:
+/// Noise handling of docs/method.md §A5 / thesis §1.4.5, one sample at a time:
 ///   y_f = MA_M(y),  v_f = MA_M(v) (filter_input) or Delay_n(v),
 ///   ẏ  = MA_M2(BackwardDifference(MA_Mp(y)))       (eq. 26; var(ẏ) = 2 var(y)/T², eq. 33)
 ///        with Mp = derivative_prefilter_length (0: the regression filter M)

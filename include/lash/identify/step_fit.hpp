@@ -1,6 +1,6 @@
 #pragma once
 /// @file step_fit.hpp
-/// Offline step-test identification of the pilot valve (SPEC B6, thesis paper 2
+/// Offline step-test identification of the pilot valve (docs/method.md §B6, thesis paper 2
 /// §2.7.1, Fig 2.8–2.10): from open-loop stepped-current data
 ///  1. split the record into segments of constant current;
 ///  2. steady part of a segment = samples later than `settle_taus`·τ after its

@@ -1,8 +1,8 @@
 #pragma once
 /// @file verdict.hpp
 /// The one decision "is this side identified, and if not, why" (issue 12 item 4), used by every
-/// estimator of SPEC A4; `lash estimate`, `lash sweep` and library users read it from the
-/// estimator (`params(s).reason`, `verdict(s)`), never re-decide it.
+/// estimator of docs/method.md §A4 (the rules: §A4.7); `lash estimate`, `lash sweep` and library
+/// users read it from the estimator (`params(s).reason`, `verdict(s)`), never re-decide it.
 ///
 /// A side (for the linear model: the model) is identified only when, in this order,
 ///  1. it was updated enough (`min_updates` per key; deadzone-deadband: (c, d) also settled)

@@ -1,6 +1,6 @@
 #pragma once
 /// @file first_order.hpp
-/// Physical figures of a discrete first-order lag y(k) = −a1·y(k−1) + b1·u(k−1) (SPEC A4,
+/// Physical figures of a discrete first-order lag y(k) = −a1·y(k−1) + b1·u(k−1) (docs/method.md §A1.3,
 /// thesis eq. 9): its static gain and its time constant. One implementation for the whole
 /// project (blocks, identify, control, sweep). Real-time safe (noexcept, no allocation).
 #include <cmath>

@@ -1,6 +1,6 @@
 #pragma once
 /// @file fit.hpp
-/// How well a simulated output follows a measured one (SPEC A6).
+/// How well a simulated output follows a measured one (docs/method.md §A6).
 ///
 /// NRMSE = sqrt(mean((y − y_sim)²)) / max|y| over a window, a fraction (0.05 = 5 %; reports
 /// that a person reads show it ×100 as `nrmse_pct`). A non-finite y_sim counts as an infinite
@@ -40,7 +40,7 @@ double nrmse(std::span<const double> y, std::span<const double> ysim) noexcept;
 double nrmse(std::span<const double> t, std::span<const double> y, std::span<const double> ysim, double t0_s,
              double t1_s) noexcept;
 
-/// Count per 1000 samples of |y − ŷ| > 3σ over t ∈ [t0, t1] (SPEC A6); NaN if the window is empty.
+/// Count per 1000 samples of |y − ŷ| > 3σ over t ∈ [t0, t1] (docs/method.md §A6); NaN if the window is empty.
 /// A non-finite ŷ counts as outside.
 double outside_3sigma_per_1000(std::span<const double> t, std::span<const double> y, std::span<const double> yhat,
                                double sigma, double t0_s, double t1_s) noexcept;

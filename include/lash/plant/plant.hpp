@@ -1,6 +1,6 @@
 #pragma once
 /// @file plant.hpp
-/// A plant is an ordered chain of blocks (SPEC A1). Timing: only the linear
+/// A plant is an ordered chain of blocks (docs/method.md §A1). Timing: only the linear
 /// part delays; deadzone, deadband, saturation act on the same sample; the
 /// side of every piecewise block is chosen by the sign of the plant input
 /// v(k−1); every state starts at 0; t_k = k·T.

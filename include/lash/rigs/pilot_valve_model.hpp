@@ -1,6 +1,6 @@
 #pragma once
 /// @file pilot_valve_model.hpp
-/// Pilot-valve pressure plant of SPEC B1 (thesis paper 2, §2.7.1, Fig 2.11):
+/// Pilot-valve pressure plant of docs/method.md §B1 (thesis paper 2, §2.7.1, Fig 2.11):
 /// solenoid current [mA] → input deadzone → first-order lag → + bias → + noise
 /// → sensor (duty-cycle encoding, uint16 on the bus).
 ///
@@ -40,7 +40,7 @@ struct PilotValveParams {
   void validate() const;
 };
 
-/// Sensor encoding of SPEC B1.
+/// Sensor encoding of docs/method.md §B1.
 inline constexpr double kDutyOffsetPct = 5.98;         ///< [%]
 inline constexpr double kKpaPerDutyPct = 48.82;        ///< [kPa/%]
 inline constexpr double kRawPerDutyPct = 65535.0 / 100.0;  ///< [counts/%]

@@ -3,16 +3,16 @@
 /// Virtual rig of the thesis's §1.6.2 (E4): an electro-hydraulic pilot valve,
 /// solenoid current in [mA] (positive → solenoid A, negative → solenoid B),
 /// pilot pressure difference out [kPa]. It starts from the paper-2 model of
-/// SPEC B1 (deadzone 288 mA, 2.15 kPa/mA, τ = 0.07 s, bias 90.1 kPa, sensor
+/// docs/method.md §B1 (deadzone 288 mA, 2.15 kPa/mA, τ = 0.07 s, bias 90.1 kPa, sensor
 /// noise σ = 7.28 kPa) and adds what the thesis says the first-order model
 /// ignores (§1.6.2: "a detailed pilot pressure model could easily be 3rd
 /// order or higher"):
 ///  - a faster second pole: the solenoid force lags the current (τ_sol);
 ///  - a time constant that shortens as the pressure rises (τ(p) = τ0/(1 + |p|/p_half));
 ///  - a slightly different solenoid B (left side), as two real solenoids are;
-///  - the sensor's 16-bit duty-cycle quantisation of SPEC B1.
+///  - the sensor's 16-bit duty-cycle quantisation of docs/method.md §B1.
 /// The measured output has the zero-current bias removed the way the thesis
-/// did (paper 2 §2.7.1, SPEC B6): before the run the rig records `bias_window_s`
+/// did (paper 2 §2.7.1, docs/method.md §B6): before the run the rig records `bias_window_s`
 /// at zero current and subtracts the mean of that record from every sample.
 ///
 /// Timing: current held over one sample period (ZOH); physics integrated at
@@ -27,16 +27,16 @@
 namespace lash::rigs {
 
 struct PilotValveRigParams {
-  double deadzone_right_mA = 288.0;    ///< solenoid A: current that starts moving the spool [mA] (SPEC B1)
+  double deadzone_right_mA = 288.0;    ///< solenoid A: current that starts moving the spool [mA] (docs/method.md §B1)
   double deadzone_left_mA = -296.0;    ///< solenoid B (negative commands) [mA]
-  double gain_right_kPa_mA = 2.15;     ///< solenoid A steady-state gain [kPa/mA] (SPEC B1)
+  double gain_right_kPa_mA = 2.15;     ///< solenoid A steady-state gain [kPa/mA] (docs/method.md §B1)
   double gain_left_kPa_mA = 2.08;      ///< solenoid B steady-state gain [kPa/mA]
   double tau0_s = 0.075;               ///< pressure time constant at zero pressure [s]
   double tau_half_pressure_kPa = 7500; ///< τ(p) = τ0/(1 + |p|/p_half): τ(1000 kPa) ≈ 0.066 s [kPa]
   double solenoid_tau_s = 0.008;       ///< the faster second pole: solenoid force lag [s]
-  double bias_kPa = 90.1;              ///< sensor reading at zero current [kPa] (SPEC B1)
-  double noise_sigma_kPa = 7.28;       ///< Gaussian sensor noise σ [kPa] (SPEC B1)
-  double quantum_kPa = 48.82 * 100.0 / 65535.0;  ///< sensor LSB: 16-bit duty (SPEC B1) [kPa]
+  double bias_kPa = 90.1;              ///< sensor reading at zero current [kPa] (docs/method.md §B1)
+  double noise_sigma_kPa = 7.28;       ///< Gaussian sensor noise σ [kPa] (docs/method.md §B1)
+  double quantum_kPa = 48.82 * 100.0 / 65535.0;  ///< sensor LSB: 16-bit duty (docs/method.md §B1) [kPa]
   double bias_window_s = 1.0;          ///< zero-current record used to remove the bias [s]
   int substeps = 10;                   ///< internal steps per sample period [-]
 

@@ -1,6 +1,6 @@
 #pragma once
 /// @file periodic.hpp
-/// Fixed-step periodic loop on absolute deadlines (SPEC B4, thesis paper 2 §2.7.3:
+/// Fixed-step periodic loop on absolute deadlines (docs/method.md §B4, thesis paper 2 §2.7.3:
 /// the xPC target ran the model every 5 ms and logged its task execution time).
 ///
 /// Step k is released at r_k = start + k·T and the loop sleeps with

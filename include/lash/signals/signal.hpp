@@ -1,6 +1,6 @@
 #pragma once
 /// @file signal.hpp
-/// Excitation signals of SPEC A2 (thesis eq. 37 and §1.6.2). Frequencies are
+/// Excitation signals of docs/method.md §A2 (thesis eq. 37 and §1.6.2). Frequencies are
 /// in rad/s; t_k = k·T is computed, never accumulated.
 #include <cstdint>
 #include <string>
