@@ -5,6 +5,7 @@
 #include <fmt/core.h>
 
 #include "cmd_hil.hpp"
+#include "console_options.hpp"
 #include "lash/hil/report.hpp"
 #include "lash/hil/schedule.hpp"
 #include "lash/hil/session.hpp"
@@ -25,6 +26,7 @@ struct RunOptions {
   std::int64_t seed = -1;
   int slave_cpu = -1;
   std::string xcp = "on";
+  ConsoleArgs console;
 };
 
 struct SimulateOptions {
@@ -137,10 +139,17 @@ int run_run(const RunOptions& o) {
   so.restart_slave = o.restart_slave;
   so.xcp = o.xcp == "on";
   so.validate();
+  std::unique_ptr<HilConsole> con;  // bound here, in the host's network namespace
+  if (o.console.enabled()) {
+    if (!so.xcp) throw InputError("", 0, "--console", "needs the master's XCP slave (not --xcp off)");
+    con = std::make_unique<HilConsole>(o.console, so.settings);
+    so.on_nodes_started = [&con] { con->start(); };
+  }
   hil::install_session_signal_handlers();
   hil::Session session(so);
   const hil::RunReport r =
       session.run([](const std::string& line) { fmt::print(stderr, "lash hil run: {}\n", line); });
+  if (con) con->stop();
   if (o.json_out) {
     std::fputs(hil::run_report_json(r).c_str(), stdout);
   } else {
@@ -229,6 +238,7 @@ void add_hil_run(CLI::App* hil, std::function<int()>& run_selected) {
       ->check(CLI::Range(-1, 4095));
   run->add_option("--xcp", ro->xcp, "The master's XCP-on-CAN slave (docs/xcp.md): on | off")
       ->check(CLI::IsMember({"on", "off"}));
+  add_console_options(run, ro->console);
 
   auto sio = std::make_shared<SimulateOptions>();
   auto* sim = hil->add_subcommand("simulate", "Closed-loop simulation through the nodes' step functions");

@@ -304,6 +304,7 @@ RunReport Session::run(const std::function<void(const std::string&)>& progress) 
                              (dir / "master.json").string()});
   if (!o_.xcp) margs.insert(margs.end(), {"--xcp", "off"});
   Child master = spawn(o_.executable, margs, false, "lash-hil-master");
+  if (o_.on_nodes_started) o_.on_nodes_started();
 
   // Supervise.
   int forwarded = 0;

@@ -18,6 +18,7 @@
 /// Not real-time code; the session process itself runs no loop.
 #include <atomic>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -42,6 +43,9 @@ struct SessionOptions {
   /// Passed on to both nodes (`--scenario FILE --compensation MODE`: the nodes load the
   /// scenario themselves; `settings.scenario` must hold the same for the report).
   std::vector<std::string> node_args;
+  /// Called once both nodes were started, in the session's network namespace (the private one
+  /// when isolated), e.g. to start a tool that joins the bus (the console's XCP client).
+  std::function<void()> on_nodes_started;
   /// Checks what can be checked before any process starts (reference, duration, loop options,
   /// output directory writable); throws InputError naming the option.
   void validate() const;

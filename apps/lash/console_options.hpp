@@ -1,0 +1,38 @@
+#pragma once
+// --console [PORT], --console-bind ADDR, --console-read-only: the live console of a run
+// (docs/console.md). Parsing and wiring only; the console is lash::console.
+#include <memory>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "lash/hil/settings.hpp"
+
+namespace lash::cli {
+
+struct ConsoleArgs {
+  std::string port;  // "" with the flag given: 0 (any free port)
+  std::string bind = "127.0.0.1";
+  bool read_only = false;
+  CLI::Option* opt = nullptr;
+  bool enabled() const { return opt && opt->count() > 0; }
+};
+
+void add_console_options(CLI::App* app, ConsoleArgs& a);
+
+/// The console of `lash hil run`: its server is bound at construction (in the caller's network
+/// namespace, so the browser reaches it from the host), prints the URL; start() joins the bench's
+/// bus through XCP (call it inside the session's namespace, once the master was started).
+class HilConsole {
+ public:
+  HilConsole(const ConsoleArgs& a, const hil::BenchSettings& s);
+  ~HilConsole();
+  void start();
+  void stop();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace lash::cli

@@ -1,0 +1,172 @@
+"""Issue 27, the live console, tested in a real browser (Debian's chromium + chromium-driver,
+python3-selenium): `lash hil run --duration 20 --console 0`, then
+
+1. the page loads from the printed URL with no console errors (and nothing from elsewhere:
+   the server's Content-Security-Policy is default-src 'self');
+2. a scope's canvas (inside [data-scope]) changes between two screenshots 1 s apart;
+3. kp set in the page's form (<form data-tune>, <input data-param="kp">): the readback
+   ([data-readback="kp"]) shows the ECU's confirmed value, master.csv's kp column takes it and
+   master.events.csv logs the calibration write; kp = 200 shows the ECU's refusal in [data-error];
+4. a POST without the token, or with it but from another origin, gets 403;
+5. frames per second in the page (requestAnimationFrame count over 10 s) is printed;
+6. the browser is closed mid-run: the run goes on and ends with exit 0.
+Skips (77) when chromium, its driver or selenium is missing. LASH_CONSOLE_SHOT=FILE saves a
+screenshot of the page (docs/console.md)."""
+import csv
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+import urllib.error
+import urllib.request
+
+LASH = os.environ.get("LASH", "lash")
+CHROMIUM = shutil.which("chromium")
+DRIVER = shutil.which("chromedriver") or "/usr/bin/chromedriver"
+try:
+    from selenium import webdriver
+    from selenium.webdriver.chrome.service import Service
+    from selenium.webdriver.common.by import By
+except ImportError:
+    print("SKIP: python3-selenium is not installed")
+    sys.exit(77)
+if not CHROMIUM or not os.path.exists(DRIVER):
+    print("SKIP: chromium or chromium-driver is not installed")
+    sys.exit(77)
+
+
+def fail(msg):
+    print("FAIL:", msg)
+    sys.exit(1)
+
+
+def post(url, body, headers):
+    req = urllib.request.Request(url, data=json.dumps(body).encode(), headers=headers, method="POST")
+    try:
+        with urllib.request.urlopen(req, timeout=5) as r:
+            return r.status
+    except urllib.error.HTTPError as e:
+        return e.code
+
+
+def browser(profile):
+    o = webdriver.ChromeOptions()
+    o.binary_location = CHROMIUM
+    for a in ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+              "--disable-background-networking", "--disable-component-update", "--disable-sync",
+              "--disable-dev-shm-usage", f"--user-data-dir={profile}", "--window-size=1400,1100"]:
+        o.add_argument(a)
+    o.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+    return webdriver.Chrome(service=Service(DRIVER), options=o)
+
+
+def canvas_png(driver):
+    c = driver.find_element(By.CSS_SELECTOR, '[data-scope="pressure"] canvas')
+    return c.screenshot_as_png
+
+
+with tempfile.TemporaryDirectory() as tmp:
+    out = os.path.join(tmp, "run")
+    run = subprocess.Popen([LASH, "hil", "run", "--duration", "20", "--console", "0", "--out-dir", out],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    url = None
+    t_end = time.time() + 15
+    while time.time() < t_end and url is None:
+        line = run.stderr.readline()
+        if not line:
+            break
+        m = re.search(r"lash console: (http://127\.0\.0\.1:(\d+)/\?token=([0-9a-f]{32}))$", line.strip())
+        if m:
+            url, port, token = m.group(1), m.group(2), m.group(3)
+    if url is None:
+        run.kill()
+        fail("no console URL printed")
+    print("URL printed:", re.sub(r"token=\w+", "token=...", url))
+    base = f"http://127.0.0.1:{port}"
+    d = browser(os.path.join(tmp, "profile"))
+    try:
+        d.get(url)
+        time.sleep(3)
+        scopes = [e.get_attribute("data-scope") for e in d.find_elements(By.CSS_SELECTOR, "[data-scope]")]
+        print("scopes:", scopes)
+        if "pressure" not in scopes:
+            fail("no [data-scope=pressure]")
+        a = canvas_png(d)
+        time.sleep(1)
+        b = canvas_png(d)
+        if a == b:
+            fail("the pressure scope did not change in 1 s")
+        print("scope canvas changed between two screenshots 1 s apart")
+
+        inp = d.find_element(By.CSS_SELECTOR, 'form[data-tune] input[data-param="kp"]')
+        inp.clear()
+        inp.send_keys("0.7")
+        inp.submit()
+        rb = d.find_element(By.CSS_SELECTOR, '[data-readback="kp"]')
+        t = time.time() + 5
+        while time.time() < t and rb.text != "0.7000":
+            time.sleep(0.1)
+        if rb.text not in ("0.7000", "0.7"):
+            fail(f"readback of kp shows {rb.text!r}, want 0.7")
+        print("kp = 0.7 set in the page, readback", rb.text)
+        t_set = time.time()
+
+        inp.clear()
+        inp.send_keys("200")
+        d.execute_script("arguments[0].min = ''; arguments[0].max = '';", inp)  # let the ECU refuse it
+        inp.submit()
+        err = d.find_element(By.CSS_SELECTOR, '[data-error="kp"]')
+        t = time.time() + 5
+        while time.time() < t and not err.text:
+            time.sleep(0.1)
+        if "ERR_OUT_OF_RANGE" not in err.text:
+            fail(f"kp = 200: data-error shows {err.text!r}")
+        print("kp = 200 refused:", err.text)
+
+        hdr = {"Content-Type": "application/json"}
+        s1 = post(base + "/api/tune", {"name": "kp", "value": 0.5}, hdr)
+        s2 = post(base + "/api/tune", {"name": "kp", "value": 0.5},
+                  dict(hdr, **{"X-Lash-Token": token, "Origin": "http://evil.example"}))
+        s3 = post(base + "/api/tune", {"name": "kp", "value": 0.5},
+                  dict(hdr, **{"X-Lash-Token": "0" * 32, "Origin": base}))
+        print(f"POST without token: {s1}; with token, other Origin: {s2}; wrong token: {s3}")
+        if (s1, s2, s3) != (403, 403, 403):
+            fail("a change without the token / from another origin was not refused with 403")
+
+        f0 = d.execute_script("return window.lashStats.frames")
+        time.sleep(10)
+        f1 = d.execute_script("return window.lashStats.frames")
+        fps = (f1 - f0) / 10.0
+        drops = d.find_element(By.CSS_SELECTOR, '[data-status="drops"]').text
+        print(f"page: {fps:.1f} frames/s (requestAnimationFrame over 10 s); drops {drops}")
+        if os.environ.get("LASH_CONSOLE_SHOT"):
+            d.save_screenshot(os.environ["LASH_CONSOLE_SHOT"])
+        errors = [e for e in d.get_log("browser") if e.get("level") == "SEVERE"]
+        if errors:
+            fail(f"console errors in the page: {errors}")
+        print("no console errors")
+    finally:
+        d.quit()  # the browser goes away mid-run
+    print("browser closed at t_run ~", round(time.time() - t_set, 1), "s after the change")
+    rest_out, rest_err = run.communicate(timeout=60)
+    if run.returncode != 0:
+        fail(f"lash hil run exited {run.returncode}: {rest_err[-2000:]}")
+    print("run ended with exit 0")
+    tet = re.search(r"master\s+TET \[us\] mean\s+([\d.]+)", rest_out)
+    print("master TET mean", tet.group(1) if tet else "?", "us (with the console attached)")
+
+    with open(os.path.join(out, "master.csv")) as f:
+        kps = [float(r["kp"]) for r in csv.DictReader(f)]
+    changes = [(a, b) for a, b in zip(kps, kps[1:]) if a != b]
+    if 0.7 not in kps or changes[0][1] != 0.7:
+        fail(f"master.csv kp changes {changes}")
+    with open(os.path.join(out, "master.events.csv")) as f:
+        cal = [l.strip() for l in f if ",calibration," in l]
+    if not cal or not cal[0].endswith(",kp,1.1207208729396014,0.7"):
+        fail(f"master.events.csv calibration lines {cal}")
+    print("master.csv kp:", changes, "; master.events.csv:", cal)
+print("PASS")
