@@ -411,3 +411,56 @@ TEST(HilSchedule, CompensationModeSwitchUnderAScenarioAndItsReplay) {
   const SimulationResult other = simulate_bench(L, mc, sc, without);
   EXPECT_NE(other.master[K1 + 1].current_mA, run.master[K1 + 1].current_mA);
 }
+
+// The same objects on the bench's own controller (no scenario): compensation 0 sets its fixed
+// inverse's edges to 0, 1 puts the (new) edges back. With Kp = Ki = Kd = 0 the PID's output is
+// its frozen integrator I > 0, so by hand (slopes 1, no smoothing): i = I under none, I + 300
+// under fixed with dz_right_mA = 300 (written while none was in force); the replay equals the run.
+TEST(HilSchedule, CompensationOfTheBenchControllerAndItsReplay) {
+  const BenchLayout L;
+  constexpr std::size_t N = 600, K1 = 300, K2 = 450;
+  MasterConfig mc = master_cfg();
+  mc.log_capacity = N + 1;
+  mc.controller.dz_inverse = {279.36, 279.36, 1.0, 1.0, 0.0};
+  SlaveConfig sc = slave_cfg();
+  sc.log_capacity = N;
+  MasterNode master(L, mc);
+  SlaveNode slave(L, sc);
+  auto xl = std::make_unique<XcpLink>();
+  master.attach(xl.get());
+  ASSERT_EQ(master.calibration().compensation, 1.0);  // the bench controller: fixed
+  MemLink link;
+  master.step(link.a(), 0.0);
+  ASSERT_TRUE(slave.wait_connect(link.b(), std::chrono::nanoseconds(0)));
+  for (std::size_t k = 1; k <= N; ++k) {
+    CalibrationPage p = master.calibration();
+    if (k == K1) {
+      p.kp = p.ki_per_s = p.kd_s = 0.0;
+      p.compensation = 0.0;
+      p.dz_right_mA = 300.0;
+      p.dither_mA = 50.0;  // no effect without a scenario (logged all the same)
+    } else if (k == K2) {
+      p.compensation = 1.0;
+    }
+    if (k == K1 || k == K2) {
+      ASSERT_TRUE(xl->pages.push(p));
+    }
+    const double t = static_cast<double>(k) * kT;
+    slave.step(link.b(), t - 0.5 * kT);
+    master.step(link.a(), t);
+  }
+  const std::vector<MasterStepLog> log(master.log().begin(), master.log().end());
+  const double I = log[K1].integrator_mA;
+  ASSERT_GT(I, 0.0);
+  ASSERT_LT(I + 300.0, 2000.0);
+  for (std::size_t k = K1; k <= N; ++k) {
+    ASSERT_EQ(log[k].integrator_mA, I) << k;
+    ASSERT_NEAR(log[k].current_mA, k < K2 ? I : I + 300.0, 1e-9) << k;
+  }
+  // K1: kp, ki_per_s, kd_s, dz_right_mA, compensation, dither_mA; K2: compensation
+  ASSERT_EQ(master.calibration_events().size(), 7u);
+  SimulationResult run;
+  run.master = log;
+  run.slave.assign(slave.log().begin(), slave.log().end());
+  expect_same(run, simulate_bench(L, mc, sc, observed_schedule(run.master, run.slave)));
+}
