@@ -209,6 +209,7 @@ Err Slave::check_write(std::uint32_t address, std::span<const std::uint8_t> byte
     }
     const double v = decode(o.type, {merged, n});
     if (!std::isfinite(v) || v < o.min || v > o.max) return Err::out_of_range;
+    if (!o.names.empty() && v != std::floor(v)) return Err::out_of_range;  // a named value: an integer
   }
   return Err::cmd_synch;  // "no error" (cmd_synch is never a write's verdict)
 }

@@ -46,6 +46,15 @@ const char* to_string(AdaptationReason r) noexcept {
   return "?";
 }
 
+bool AdaptationSettings::valid() const noexcept {
+  return std::isfinite(rate_limit_per_s) && rate_limit_per_s > 0 && std::isfinite(settle_s) && settle_s >= 0 &&
+         std::isfinite(hold_s) && hold_s >= 0 && std::isfinite(min_ratio) && std::isfinite(max_ratio) &&
+         min_ratio >= 0 && min_ratio <= 1 && max_ratio >= 1 && std::isfinite(dither_amplitude) &&
+         dither_amplitude >= 0 && std::isfinite(dither_period_s) && dither_period_s > 0 &&
+         std::isfinite(min_excitation_ratio) && min_excitation_ratio >= 0 && std::isfinite(tolerance_ratio) &&
+         tolerance_ratio >= 0;
+}
+
 void AdaptationSettings::validate() const {
   require(std::isfinite(rate_limit_per_s) && rate_limit_per_s > 0, "adaptation rate_limit must be > 0");
   require(std::isfinite(settle_s) && settle_s >= 0, "adaptation settle_s must be >= 0 [s]");
@@ -67,6 +76,23 @@ ParameterGate::ParameterGate(double nominal, double dt_s, const AdaptationSettin
       tol_(s.tolerance_ratio * nominal),
       settle_n_(samples(s.settle_s, dt_s)),
       hold_n_(samples(s.hold_s, dt_s)) {}
+
+void ParameterGate::retune(const AdaptationSettings& s, double dt_s) noexcept {
+  max_step_ = s.rate_limit_per_s * dt_s;
+  lo_ = s.min_ratio * nominal_;
+  hi_ = s.max_ratio * nominal_;
+  tol_ = s.tolerance_ratio * nominal_;
+  settle_n_ = samples(s.settle_s, dt_s);
+  hold_n_ = samples(s.hold_s, dt_s);
+}
+
+void ParameterGate::restart(double nominal, const AdaptationSettings& s, double dt_s) noexcept {
+  nominal_ = value_ = nominal;
+  retune(s, dt_s);
+  moving_ = adapted_ = false;
+  valid_run_ = since_valid_ = 0;
+  reason_ = AdaptationReason::nominal;
+}
 
 double ParameterGate::step(bool identified, double estimate) noexcept {
   double target = value_;
@@ -106,6 +132,12 @@ double ParameterGate::step(bool identified, double estimate) noexcept {
 
 Dither::Dither(double amplitude, double period_s, double dt_s) noexcept
     : amplitude_(amplitude), half_(std::max<std::uint64_t>(1, samples(0.5 * period_s, dt_s))) {}
+
+void Dither::retune(double amplitude, double period_s, double dt_s) noexcept {
+  amplitude_ = amplitude;
+  half_ = std::max<std::uint64_t>(1, samples(0.5 * period_s, dt_s));
+  if (k_ >= 2 * half_) k_ = 0;
+}
 
 void DeadzoneAdapter::validate(const EstimatorConfig& e) {
   require(e.model == ModelKind::input_deadzone, "the deadzone compensator needs the input-deadzone estimator");

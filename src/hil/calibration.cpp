@@ -5,19 +5,34 @@
 namespace lash::hil {
 
 namespace {
-// Limits: what the law accepts (gains finite and >= 0, edges inside the current range) with a
-// margin a tuning session needs; the defaults of config/control/lash_gains.toml lie well inside.
-constexpr std::array<CalibrationField, 7> kCalibration{{
-    {"kp", &CalibrationPage::kp, "mA/kPa", 0.0, 100.0, "PID proportional gain Kp"},
-    {"ki_per_s", &CalibrationPage::ki_per_s, "mA/(kPa s)", 0.0, 10000.0, "PID integral gain Ki"},
-    {"kd_s", &CalibrationPage::kd_s, "mA s/kPa", 0.0, 10.0, "PID derivative gain Kd"},
-    {"n_per_s", &CalibrationPage::n_per_s, "1/s", 0.0, 100000.0, "PID derivative filter N (0 = unfiltered)"},
+// Limits: what the law accepts (gains finite and >= 0, edges inside the current range, the
+// adaptation's settings inside AdaptationSettings::valid()) with a margin a tuning session
+// needs; the defaults of config/control/lash_gains.toml, of AdaptationSettings and of the shipped
+// scenarios lie well inside. One set of limits for both laws (the A2L does not depend on
+// --scenario): objects the running law does not have are kept and logged, without effect
+// (docs/xcp.md).
+constexpr const char* kModeNames[] = {"none", "fixed", "adaptive"};  // CompensationMode's order
+constexpr std::array<CalibrationField, 12> kCalibration{{
+    {"kp", &CalibrationPage::kp, "mA/kPa", 0.0, 100.0, "PID proportional gain Kp", {}},
+    {"ki_per_s", &CalibrationPage::ki_per_s, "mA/(kPa s)", 0.0, 10000.0, "PID integral gain Ki", {}},
+    {"kd_s", &CalibrationPage::kd_s, "mA s/kPa", 0.0, 10.0, "PID derivative gain Kd", {}},
+    {"n_per_s", &CalibrationPage::n_per_s, "1/s", 0.0, 100000.0, "PID derivative filter N (0 = unfiltered)", {}},
     {"dz_right_mA", &CalibrationPage::dz_right_mA, "mA", 0.0, 2000.0,
-     "deadzone inverse: nominal right edge (bench controller)"},
+     "deadzone inverse: nominal right edge (fixed, and the start of adaptive)", {}},
     {"dz_left_mA", &CalibrationPage::dz_left_mA, "mA", 0.0, 2000.0,
-     "deadzone inverse: nominal left edge, magnitude (bench controller)"},
+     "deadzone inverse: nominal left edge, magnitude (fixed, and the start of adaptive)", {}},
     {"reference_offset_kPa", &CalibrationPage::reference_offset_kPa, "kPa", -4000.0, 4000.0,
-     "offset added to the reference r(m)"},
+     "offset added to the reference r(m)", {}},
+    {"compensation", &CalibrationPage::compensation, "", 0.0, 2.0,
+     "deadzone compensation: 0 none, 1 fixed, 2 adaptive (bench controller: 2 acts as 1)", kModeNames},
+    {"adapt_rate_mA_per_s", &CalibrationPage::adapt_rate_mA_per_s, "mA/s", 0.001, 100000.0,
+     "adaptation: rate limit of the inverse's edges (scenario law)", {}},
+    {"adapt_tolerance", &CalibrationPage::adapt_tolerance, "", 0.0, 1.0,
+     "adaptation: dead band, fraction of the nominal edge (scenario law)", {}},
+    {"adapt_settle_s", &CalibrationPage::adapt_settle_s, "s", 0.0, 60.0,
+     "adaptation: time the verdict must hold before its values are used (scenario law)", {}},
+    {"dither_mA", &CalibrationPage::dither_mA, "mA", 0.0, 500.0,
+     "adaptation: square-wave dither amplitude on u (scenario law, adaptive only)", {}},
 }};
 
 constexpr std::array<MeasurementField, 8> kMeasurements{{

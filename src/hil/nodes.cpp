@@ -262,14 +262,34 @@ CalibrationPage initial_calibration(const MasterConfig& c) noexcept {
   p.ki_per_s = g.ki_per_s;
   p.kd_s = g.kd_s;
   p.n_per_s = g.n_per_s;
-  p.dz_right_mA = c.controller.dz_inverse.offset_right;
-  p.dz_left_mA = c.controller.dz_inverse.offset_left;
+  const DeadzoneInverseParams& n = c.law ? c.law->compensation.nominal : c.controller.dz_inverse;
+  p.dz_right_mA = n.offset_right;
+  p.dz_left_mA = n.offset_left;
+  p.compensation = static_cast<double>(c.law ? c.law->compensation.mode : CompensationMode::fixed);
+  const AdaptationSettings a = c.law ? c.law->compensation.adaptation : AdaptationSettings{};
+  p.adapt_rate_mA_per_s = a.rate_limit_per_s;
+  p.adapt_tolerance = a.tolerance_ratio;
+  p.adapt_settle_s = a.settle_s;
+  p.dither_mA = a.dither_amplitude;
   return p;
 }
 
-// A new calibration page at a step boundary: the law's gains, the bench controller's inverse
-// edges and the reference offset change together, before the step's law runs; one event per
-// object that changed.
+namespace {
+// A page's compensation value as a mode (the XCP slave admits only the integers 0..2).
+CompensationMode mode_of(double v) noexcept {
+  return v <= 0.5 ? CompensationMode::none : (v <= 1.5 ? CompensationMode::fixed : CompensationMode::adaptive);
+}
+}  // namespace
+
+// A new calibration page at a step boundary: the law's gains, the compensation (mode, nominal
+// edges, adaptation settings) and the reference offset change together, before the step's law
+// runs; one event per object that changed.
+//  - scenario law: the PID's gains; the compensator's nominal edges (set_nominal), adaptation
+//    settings (set_adaptation) and mode (set_mode), each only when it changed (a new nominal or
+//    mode restarts the compensation from the nominal inverse; adaptive_compensator.hpp);
+//  - bench controller: the PID's gains; its fixed inverse gets the edges, or 0 for
+//    compensation 0 (none); compensation 2 acts as 1 (no estimator), the adaptation settings
+//    have no effect (logged all the same).
 void MasterNode::apply_calibration(const CalibrationPage& p, double now_s) noexcept {
   const auto fields = calibration_fields();
   for (std::size_t i = 0; i < fields.size(); ++i) {
@@ -278,11 +298,30 @@ void MasterNode::apply_calibration(const CalibrationPage& p, double now_s) noexc
     if (n_cal_events_ < cal_events_.size())
       cal_events_[n_cal_events_++] = CalibrationEvent{k_, now_s, static_cast<std::uint16_t>(i), before, after};
   }
+  const CalibrationPage before = cal_;
   cal_ = p;
   const PidGains g{p.kp, p.ki_per_s, p.kd_s, p.n_per_s};
   controller_.pid().set_gains(g);
   if (pid_) pid_->set_gains(g);
-  controller_.deadzone_inverse().set_offsets(p.dz_right_mA, p.dz_left_mA);
+  const CompensationMode mode = mode_of(p.compensation);
+  if (comp_) {
+    if (p.dz_right_mA != before.dz_right_mA || p.dz_left_mA != before.dz_left_mA)
+      comp_->set_nominal(p.dz_right_mA, p.dz_left_mA);
+    if (p.adapt_rate_mA_per_s != before.adapt_rate_mA_per_s || p.adapt_tolerance != before.adapt_tolerance ||
+        p.adapt_settle_s != before.adapt_settle_s || p.dither_mA != before.dither_mA) {
+      AdaptationSettings a = comp_->config().adaptation;
+      a.rate_limit_per_s = p.adapt_rate_mA_per_s;
+      a.tolerance_ratio = p.adapt_tolerance;
+      a.settle_s = p.adapt_settle_s;
+      a.dither_amplitude = p.dither_mA;
+      comp_->set_adaptation(a);  // inside the limits: valid (a refusal would keep the old settings)
+    }
+    comp_->set_mode(mode);
+  }
+  if (mode == CompensationMode::none)
+    controller_.deadzone_inverse().set_offsets(0.0, 0.0);
+  else
+    controller_.deadzone_inverse().set_offsets(p.dz_right_mA, p.dz_left_mA);
 }
 
 void MasterNode::go(MasterState to, NodeEventKind why, double now_s) noexcept {
@@ -405,7 +444,7 @@ bool MasterNode::step(can::Bus& bus, double now_s) noexcept {
     l.dropped = dropped;
     l.current_mA = send_cmd ? current_mA_ : 0.0;
     l.integrator_mA = pid_ ? pid_->integrator() : controller_.pid().integrator();
-    if (comp_ && cfg_.law->compensation.mode != CompensationMode::none) {
+    if (comp_ && comp_->config().mode != CompensationMode::none) {
       l.inverse_right_mA = comp_->inverse().params().offset_right;
       l.inverse_left_mA = -comp_->inverse().params().offset_left;
     }
@@ -453,7 +492,7 @@ CompensationState MasterNode::compensation() const noexcept {
   CompensationState c;
   if (!comp_) return c;
   c.on = true;
-  c.mode = cfg_.law->compensation.mode;
+  c.mode = comp_->config().mode;  // as calibrated (docs/xcp.md)
   if (c.mode != CompensationMode::none) {
     c.right = comp_->inverse().params().offset_right;
     c.left = -comp_->inverse().params().offset_left;

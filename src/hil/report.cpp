@@ -244,7 +244,9 @@ std::string scenario_json(const ScenarioFigures& f) {
   j["tracking"] = tracking_json(f.window);
   if (f.before_drift) j["tracking_before_drift"] = tracking_json(*f.before_drift);
   if (f.after_drift) j["tracking_after_drift"] = tracking_json(*f.after_drift);
-  j["compensation"] = {{"final", {{"right", c.right}, {"left", c.left}}}, {"unit", "mA"}};
+  // final_mode: the mode at the end, as calibrated over XCP (compensation_mode: the start's).
+  j["compensation"] = {
+      {"final", {{"right", c.right}, {"left", c.left}}}, {"final_mode", to_string(c.mode)}, {"unit", "mA"}};
   j["adaptation"] = {{"updates", c.updates},
                      {"reason", to_string(c.reason)},
                      {"estimator_identified", c.estimator_identified},

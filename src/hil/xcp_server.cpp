@@ -12,7 +12,8 @@ std::vector<xcp::Object> master_objects() {
   std::vector<xcp::Object> o;
   std::uint32_t a = kXcpCalibrationBase;
   for (const auto& f : calibration_fields()) {
-    o.push_back({f.name, xcp::Kind::characteristic, xcp::Type::f64, f.unit, f.min, f.max, a, f.doc, {}});
+    o.push_back({f.name, xcp::Kind::characteristic, xcp::Type::f64, f.unit, f.min, f.max, a, f.doc,
+                 std::vector<std::string>(f.names.begin(), f.names.end())});
     a += 8;
   }
   a = kXcpMeasurementBase;

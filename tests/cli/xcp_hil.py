@@ -10,8 +10,13 @@
 3. `lash xcp set kp 0.7` mid-run: master.csv's kp column changes once, to 0.7, at the step
    master.events.csv logs; `get kp` reads 0.7; `hil simulate --schedule` equals the run (0 kPa).
 4. `lash xcp daq` of 5 measurements: consecutive control steps (no sample missing) whose values
-   equal master.csv's at the same control step."""
+   equal master.csv's at the same control step.
+5. Under `hil run --scenario valve_deadzone_drift.toml`: `lash xcp set compensation 0` (adaptive ->
+   none) mid-run; 1.5 and 3 are refused (ERR_OUT_OF_RANGE); master.csv's compensation column
+   changes once, at the step master.events.csv logs (2 -> 0); the run ends in mode none; and
+   `hil simulate --schedule` with the scenario equals the run (0 kPa)."""
 import csv
+import json
 import os
 import re
 import subprocess
@@ -243,6 +248,42 @@ for r in rows:
         assert float(r[c]) == float(ref[c]), (c, r, ref)
 print(f"daq: {len(rows)} consecutive samples (control steps {steps[0]}..{steps[-1]}) equal master.csv")
 assert any(e["event"] == "ccp_connected" for e in ev), "the CCP handshake must still work"
+
+# ----------------------------------------------------------------------------- 5. --scenario
+# The scenario law's compensation mode calibrated mid-run (docs/xcp.md): adaptive (2) -> none (0).
+drift = os.path.join(hil_netns.source_dir(), "config", "scenarios", "closed_loop", "valve_deadzone_drift.toml")
+sdir = os.path.join(out, "scenario")
+srun = subprocess.Popen([LASH, "hil", "run", "--no-isolate", "--scenario", drift, "--compensation", "adaptive",
+                         "--duration", "10", "--json", "--out-dir", sdir],
+                        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+time.sleep(2.0)
+assert float(lash("xcp", "--bus", BUS, "--a2l", a2l, "get", "compensation").stdout.split("=")[1].split()[0]) == 2
+r = lash("xcp", "--bus", BUS, "--a2l", a2l, "set", "compensation", "1.5", check=False)  # a mode is an integer
+assert r.returncode == 1 and "ERR_OUT_OF_RANGE (0x22)" in r.stderr, r.stderr
+r = lash("xcp", "--bus", BUS, "--a2l", a2l, "set", "compensation", "3", check=False)    # A2L limits 0..2
+assert r.returncode == 1 and "ERR_OUT_OF_RANGE (0x22)" in r.stderr, r.stderr
+lash("xcp", "--bus", BUS, "--a2l", a2l, "set", "compensation", "0")
+assert float(lash("xcp", "--bus", BUS, "--a2l", a2l, "get", "compensation").stdout.split("=")[1].split()[0]) == 0
+stdout, stderr = srun.communicate(timeout=90)
+assert srun.returncode == 0, stderr
+rep = json.loads(stdout)
+m = list(csv.DictReader(open(os.path.join(sdir, "master.csv"))))
+mode = [float(r["compensation"]) for r in m]
+changes = [i for i in range(1, len(mode)) if mode[i] != mode[i - 1]]
+assert mode[0] == 2 and len(changes) == 1 and mode[changes[0]] == 0, [(i, mode[i]) for i in changes]
+step_changed = int(m[changes[0]]["step"])
+cal = [e for e in csv.DictReader(open(os.path.join(sdir, "master.events.csv"))) if e["event"] == "calibration"]
+assert len(cal) == 1 and cal[0]["name"] == "compensation" and float(cal[0]["old"]) == 2 and \
+    float(cal[0]["new"]) == 0 and int(cal[0]["step"]) == step_changed, cal
+# The compensator at the end of the run: mode none, no inverse (edges 0).
+fin = rep["compensation"]["final"]
+assert rep["compensation_mode"] == "adaptive" and rep["compensation"]["final_mode"] == "none" and \
+    fin == {"right": 0.0, "left": 0.0}, rep["compensation"]
+sim = lash("hil", "simulate", "--schedule", os.path.join(sdir, "master.csv"), "--scenario", drift, "--compensation",
+           "adaptive", "-o", os.path.join(out, "sim_scenario.csv"))
+assert "max |log - simulation| 0 kPa, 0 mA" in sim.stdout, sim.stdout
+print(f"--scenario: compensation 2 -> 0 at step {step_changed}; logged; final {rep['compensation']}; "
+      f"{sim.stdout.splitlines()[0]}")
 
 # --xcp off: no slave on the bus (the tool times out), the run itself is unaffected.
 off = subprocess.Popen([LASH, "hil", "run", "--no-isolate", "--duration", "3", "--xcp", "off", "--out-dir",

@@ -236,3 +236,78 @@ TEST(BacklashCompensator, StaleSamplesRestartTheEstimatorAndHoldTheInverse) {
   EXPECT_NEAR(comp.inverse().params().right, 0.004, 1e-4);
   EXPECT_NEAR(comp.inverse().params().left, 0.0065, 1e-4);
 }
+
+// Calibration setters (docs/xcp.md): between samples, noexcept; numbers by hand from the
+// inverse's definition (slopes 1, no smoothing: v = u + c_r for u > 0, v = u − |c_l| for u < 0).
+TEST(CompensatorCalibration, ModeSwitchNominalEdgesAndDither) {
+  DeadzoneCompensator c(valve(CompensationMode::fixed));
+  EXPECT_EQ(c.command(100.0), 388.0);  // 100 + 288
+  EXPECT_EQ(c.command(-100.0), -396.0);  // −100 − 296
+  ASSERT_TRUE(c.set_mode(CompensationMode::none));
+  EXPECT_EQ(c.command(100.0), 100.0);
+  EXPECT_EQ(c.in_use().right, 0.0);
+  ASSERT_TRUE(c.set_nominal(300.0, 310.0));  // in none: kept for fixed/adaptive
+  ASSERT_TRUE(c.set_mode(CompensationMode::fixed));
+  EXPECT_EQ(c.command(100.0), 400.0);
+  EXPECT_EQ(c.command(-100.0), -410.0);
+  EXPECT_EQ(c.in_use().left, -310.0);
+  // refused: nothing changes
+  EXPECT_FALSE(c.set_nominal(-1.0, 310.0));
+  EXPECT_FALSE(c.set_nominal(300.0, std::nan("")));
+  EXPECT_FALSE(c.set_mode(static_cast<CompensationMode>(3)));
+  EXPECT_EQ(c.command(100.0), 400.0);
+  EXPECT_EQ(c.config().mode, CompensationMode::fixed);
+  // adaptive with a dither of 5 mA, period 4 samples: +5, +5, −5, −5, +5 on u before the inverse
+  AdaptationSettings a = c.config().adaptation;
+  a.dither_amplitude = 5.0;
+  a.dither_period_s = 4.0 * c.config().estimator.dt_s;
+  ASSERT_TRUE(c.set_adaptation(a));
+  ASSERT_TRUE(c.set_mode(CompensationMode::adaptive));
+  const double want[] = {405.0, 405.0, 395.0, 395.0, 405.0};
+  for (double w : want) EXPECT_EQ(c.command(100.0), w);
+  // a mode change restarts the dither at +A
+  ASSERT_TRUE(c.set_mode(CompensationMode::fixed));
+  ASSERT_TRUE(c.set_mode(CompensationMode::adaptive));
+  EXPECT_EQ(c.command(100.0), 405.0);
+  a.rate_limit_per_s = 0.0;  // invalid (ρ > 0)
+  EXPECT_FALSE(c.set_adaptation(a));
+  EXPECT_EQ(c.config().adaptation.dither_amplitude, 5.0);
+}
+
+// The gate: nominal 300, T = 0.01 s, ρ = 100/s (1 per sample), dead band 0.08 × 300 = 24,
+// settle 0: an estimate of 350 (gap 50 > 24) is followed at 1 per sample; after retune(ρ = 500)
+// at 5 per sample from where it is; restart(200) puts it at 200, never adapted.
+TEST(CompensatorCalibration, GateRetuneKeepsItsValueAndRestartDropsIt) {
+  AdaptationSettings s;
+  s.settle_s = 0.0;
+  ParameterGate g(300.0, 0.01, s);
+  EXPECT_EQ(g.step(true, 350.0), 301.0);
+  EXPECT_EQ(g.step(true, 350.0), 302.0);
+  s.rate_limit_per_s = 500.0;
+  g.retune(s, 0.01);
+  EXPECT_EQ(g.step(true, 350.0), 307.0);
+  EXPECT_EQ(g.nominal(), 300.0);
+  g.restart(200.0, s, 0.01);
+  EXPECT_EQ(g.value(), 200.0);
+  EXPECT_EQ(g.reason(), AdaptationReason::nominal);
+  // 350 lies inside [0.25, 4] × 200 = [50, 800], gap 150 > dead band 0.08 × 200 = 16: +5 per sample
+  EXPECT_EQ(g.step(true, 350.0), 205.0);
+}
+
+// An adapted inverse switched to fixed is the nominal inverse again, and back to adaptive it
+// starts from the nominal values (the carts' gaps, adapted to 4 / 6.5 mm from nominal 5 mm).
+TEST(CompensatorCalibration, AdaptedValuesDroppedOnAModeSwitch) {
+  BacklashCompensator comp(carts(CompensationMode::adaptive));
+  RefBacklash b{0.004, 0.0065, -0.0065};
+  for (int k = 0; k < 30000; ++k) {
+    const double w = 0.05 * std::sin(2.0 * std::numbers::pi * k * kDt / 4.0);
+    comp.observe(w, b.step(w), true);
+  }
+  ASSERT_NEAR(comp.inverse().params().right, 0.004, 1e-4);
+  ASSERT_TRUE(comp.set_mode(CompensationMode::fixed));
+  EXPECT_EQ(comp.inverse().params().right, 0.005);
+  EXPECT_EQ(comp.inverse().params().left, 0.005);
+  ASSERT_TRUE(comp.set_mode(CompensationMode::adaptive));
+  EXPECT_EQ(comp.gate(Side::right).value(), 0.005);
+  EXPECT_EQ(comp.reason(), AdaptationReason::nominal);
+}

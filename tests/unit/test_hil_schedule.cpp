@@ -290,3 +290,177 @@ TEST(HilSchedule, CalibrationPageAtTheStepBoundaryAndItsReplay) {
   const SimulationResult other = simulate_bench(L, mc, sc, without);
   EXPECT_NE(other.master[N].current_mA, run.master[N].current_mA);
 }
+
+// XCP calibration of the scenario law (--scenario): the compensation mode, the nominal edges and
+// the dither switched mid-run through the XcpLink. With Kp = Ki = 0 (written in the first page)
+// the PID's output is its frozen integrator I, so u = I + 0.465·r from the logged columns, and
+// the current follows from the inverse's definition by hand (slopes 1, no smoothing):
+//   none:     i = u
+//   fixed:    i = u + 300 (u > 0), u − 310 (u < 0)       (the new nominal edges of the second page)
+//   adaptive: i = fixed(u + d), d = +10 for 10 samples, −10 for 10 (dither 10 mA, period 0.1 s,
+//             restarted by the mode change), edges still 300/310 (settle 0.5 s = 100 samples)
+// and the replay of the logged schedule equals the run bit for bit.
+TEST(HilSchedule, CompensationModeSwitchUnderAScenarioAndItsReplay) {
+  const BenchLayout L;
+  constexpr std::size_t N = 1000, K1 = 400, K2 = 600, K3 = 800;
+  constexpr double ff = 0.465;
+  MasterConfig mc = master_cfg();
+  mc.log_capacity = N + 1;
+  mc.reference = SignalSpec{};
+  mc.reference.kind = Waveform::sine;
+  mc.reference.amplitude = 600.0;
+  mc.reference.frequency_rad_s = 2.0 * std::numbers::pi;
+  CompensatedLaw law;
+  law.pid.dt_s = kT;
+  law.pid.gains.kp = 0.5;
+  law.pid.gains.ki_per_s = 10.0;
+  law.pid.anti_windup = AntiWindup::clamp;
+  law.pid.output_min = -2000.0;
+  law.pid.output_max = 2000.0;
+  law.feedforward = ff;
+  law.compensation.mode = CompensationMode::adaptive;
+  law.compensation.nominal.offset_right = 288.0;
+  law.compensation.nominal.offset_left = 296.0;
+  law.compensation.estimator.model = ModelKind::input_deadzone;
+  law.compensation.estimator.dt_s = kT;
+  law.compensation.estimator.guess_right = 432.0;
+  law.compensation.estimator.guess_left = -444.0;
+  mc.law = law;
+  SlaveConfig sc = slave_cfg();
+  sc.log_capacity = N;
+  sc.rig = RigPlant{};
+  sc.rig->seed = 7;
+  MasterNode master(L, mc);
+  SlaveNode slave(L, sc);
+  auto xl = std::make_unique<XcpLink>();
+  master.attach(xl.get());
+  ASSERT_EQ(master.calibration().compensation, 2.0);  // the scenario's mode, edges and settings
+  ASSERT_EQ(master.calibration().dz_right_mA, 288.0);
+  ASSERT_EQ(master.calibration().adapt_settle_s, 0.5);
+  MemLink link;
+  master.step(link.a(), 0.0);
+  ASSERT_TRUE(slave.wait_connect(link.b(), std::chrono::nanoseconds(0)));
+  for (std::size_t k = 1; k <= N; ++k) {
+    CalibrationPage p = master.calibration();
+    if (k == K1) {
+      p.kp = p.ki_per_s = 0.0;
+      p.compensation = 0.0;
+    } else if (k == K2) {
+      p.compensation = 1.0;
+      p.dz_right_mA = 300.0;
+      p.dz_left_mA = 310.0;
+    } else if (k == K3) {
+      p.compensation = 2.0;
+      p.dither_mA = 10.0;
+    }
+    if (k == K1 || k == K2 || k == K3) {
+      ASSERT_TRUE(xl->pages.push(p));
+    }
+    const double t = static_cast<double>(k) * kT;
+    slave.step(link.b(), t - 0.5 * kT);
+    master.step(link.a(), t);
+  }
+  const std::vector<MasterStepLog> log(master.log().begin(), master.log().end());
+  auto fixed = [](double u) { return u > 0.0 ? u + 300.0 : (u < 0.0 ? u - 310.0 : 0.0); };
+  const double I = log[K1].integrator_mA;
+  for (std::size_t k = K1; k <= N; ++k) {
+    const MasterStepLog& m = log[k];
+    ASSERT_EQ(m.state, MasterState::running) << k;
+    ASSERT_EQ(m.integrator_mA, I) << k;
+    const double u = I + ff * m.reference_kPa;
+    if (k < K2) {
+      ASSERT_EQ(m.calibration.compensation, 0.0) << k;
+      ASSERT_NEAR(m.current_mA, u, 1e-9) << k;
+      ASSERT_EQ(m.inverse_right_mA, 0.0) << k;
+    } else if (k < K3) {
+      ASSERT_EQ(m.calibration.compensation, 1.0) << k;
+      ASSERT_NEAR(m.current_mA, fixed(u), 1e-9) << k;
+      ASSERT_EQ(m.inverse_right_mA, 300.0) << k;
+      ASSERT_EQ(m.inverse_left_mA, -310.0) << k;
+    } else if (k < K3 + 100) {
+      ASSERT_EQ(m.calibration.compensation, 2.0) << k;
+      const double d = (k - K3) % 20 < 10 ? 10.0 : -10.0;
+      ASSERT_NEAR(m.current_mA, fixed(u + d), 1e-9) << k;
+      ASSERT_EQ(m.inverse_right_mA, 300.0) << k;
+    }
+  }
+  // One event per changed object, in table order within a page.
+  const auto ev = master.calibration_events();
+  std::vector<std::string> names;
+  for (const auto& e : ev) names.emplace_back(calibration_fields()[e.field].name);
+  const std::vector<std::string> want{"kp", "ki_per_s", "compensation", "dz_right_mA", "dz_left_mA",
+                                      "compensation", "compensation", "dither_mA"};
+  ASSERT_EQ(names, want);
+  EXPECT_EQ(ev[2].old_value, 2.0);
+  EXPECT_EQ(ev[2].new_value, 0.0);
+  EXPECT_EQ(ev[2].step, K1);
+  EXPECT_EQ(ev[5].old_value, 0.0);
+  EXPECT_EQ(ev[5].new_value, 1.0);
+  EXPECT_EQ(ev[6].new_value, 2.0);
+  EXPECT_EQ(ev[6].step, K3);
+  EXPECT_EQ(master.compensation().mode, CompensationMode::adaptive);
+
+  SimulationResult run;
+  run.master = log;
+  run.slave.assign(slave.log().begin(), slave.log().end());
+  const FrameSchedule fs = observed_schedule(run.master, run.slave);
+  ASSERT_EQ(fs.calibration.size(), 4u);  // the first control step's page, and the three changes
+  expect_same(run, simulate_bench(L, mc, sc, fs));
+  FrameSchedule without = fs;  // without the pages the replay departs from the run
+  without.calibration.resize(1);
+  const SimulationResult other = simulate_bench(L, mc, sc, without);
+  EXPECT_NE(other.master[K1 + 1].current_mA, run.master[K1 + 1].current_mA);
+}
+
+// The same objects on the bench's own controller (no scenario): compensation 0 sets its fixed
+// inverse's edges to 0, 1 puts the (new) edges back. With Kp = Ki = Kd = 0 the PID's output is
+// its frozen integrator I > 0, so by hand (slopes 1, no smoothing): i = I under none, I + 300
+// under fixed with dz_right_mA = 300 (written while none was in force); the replay equals the run.
+TEST(HilSchedule, CompensationOfTheBenchControllerAndItsReplay) {
+  const BenchLayout L;
+  constexpr std::size_t N = 600, K1 = 300, K2 = 450;
+  MasterConfig mc = master_cfg();
+  mc.log_capacity = N + 1;
+  mc.controller.dz_inverse = {279.36, 279.36, 1.0, 1.0, 0.0};
+  SlaveConfig sc = slave_cfg();
+  sc.log_capacity = N;
+  MasterNode master(L, mc);
+  SlaveNode slave(L, sc);
+  auto xl = std::make_unique<XcpLink>();
+  master.attach(xl.get());
+  ASSERT_EQ(master.calibration().compensation, 1.0);  // the bench controller: fixed
+  MemLink link;
+  master.step(link.a(), 0.0);
+  ASSERT_TRUE(slave.wait_connect(link.b(), std::chrono::nanoseconds(0)));
+  for (std::size_t k = 1; k <= N; ++k) {
+    CalibrationPage p = master.calibration();
+    if (k == K1) {
+      p.kp = p.ki_per_s = p.kd_s = 0.0;
+      p.compensation = 0.0;
+      p.dz_right_mA = 300.0;
+      p.dither_mA = 50.0;  // no effect without a scenario (logged all the same)
+    } else if (k == K2) {
+      p.compensation = 1.0;
+    }
+    if (k == K1 || k == K2) {
+      ASSERT_TRUE(xl->pages.push(p));
+    }
+    const double t = static_cast<double>(k) * kT;
+    slave.step(link.b(), t - 0.5 * kT);
+    master.step(link.a(), t);
+  }
+  const std::vector<MasterStepLog> log(master.log().begin(), master.log().end());
+  const double I = log[K1].integrator_mA;
+  ASSERT_GT(I, 0.0);
+  ASSERT_LT(I + 300.0, 2000.0);
+  for (std::size_t k = K1; k <= N; ++k) {
+    ASSERT_EQ(log[k].integrator_mA, I) << k;
+    ASSERT_NEAR(log[k].current_mA, k < K2 ? I : I + 300.0, 1e-9) << k;
+  }
+  // K1: kp, ki_per_s, kd_s, dz_right_mA, compensation, dither_mA; K2: compensation
+  ASSERT_EQ(master.calibration_events().size(), 7u);
+  SimulationResult run;
+  run.master = log;
+  run.slave.assign(slave.log().begin(), slave.log().end());
+  expect_same(run, simulate_bench(L, mc, sc, observed_schedule(run.master, run.slave)));
+}

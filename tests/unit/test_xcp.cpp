@@ -180,6 +180,34 @@ TEST(Xcp, OutOfRangeProtectedAndDenied) {
   EXPECT_TRUE(x.writes.size() == 1u);  // only the mode write
 }
 
+// A named characteristic (COMPU_METHOD TAB_VERB, the master's compensation mode) stored as f64:
+// only integers inside its limits are written. 1.5 = 0x3FF8000000000000, 1.0 = 0x3FF0000000000000.
+TEST(Xcp, NamedValueOnlyAnInteger) {
+  xcp::SlaveConfig c = config();
+  c.objects[0] = {"comp", xcp::Kind::characteristic, xcp::Type::f64, "", 0.0, 2.0, 0x10010, "", {"none", "fixed", "adaptive"}};
+  std::vector<Frame> out;
+  xcp::Slave s{c, [&](const Frame& f) { out.push_back(f); }, nullptr};
+  auto one = [&](Bytes b, std::size_t answers = 1) {
+    Frame f;
+    f.id = 0x7F0;
+    f.len = static_cast<std::uint8_t>(b.size());
+    std::memcpy(f.data.data(), b.data(), b.size());
+    out.clear();
+    s.on_frame(f);
+    EXPECT_EQ(out.size(), answers);
+    return out.empty() ? Bytes{} : Bytes(out[0].data.begin(), out[0].data.begin() + out[0].len);
+  };
+  ASSERT_EQ(one({0xFF, 0x00}).at(0), 0xFF);
+  one({0xF6, 0, 0, 0, 0x10, 0x00, 0x01, 0x00});
+  one({0xF0, 0x08, 0, 0, 0, 0, 0, 0}, 0);  // master block mode: no answer yet
+  EXPECT_EQ(one({0xEF, 0x02, 0xF8, 0x3F}), (Bytes{0xFE, 0x22}));  // 1.5: ERR_OUT_OF_RANGE
+  EXPECT_EQ(s.get(*s.find("comp")), 0.0);
+  one({0xF6, 0, 0, 0, 0x10, 0x00, 0x01, 0x00});
+  one({0xF0, 0x08, 0, 0, 0, 0, 0, 0}, 0);  // master block mode: no answer yet
+  EXPECT_EQ(one({0xEF, 0x02, 0xF0, 0x3F}), (Bytes{0xFF}));
+  EXPECT_EQ(s.get(*s.find("comp")), 1.0);
+}
+
 TEST(Xcp, DynamicDaqListAndOdtLayout) {
   Fixture x;
   x.connect();

@@ -95,7 +95,8 @@ struct Object {
   double min = 0.0, max = 0.0;   ///< limits (A2L LowerLimit/UpperLimit); writes outside are refused
   std::uint32_t address = 0;     ///< ECU_ADDRESS
   std::string description;
-  /// A characteristic whose values are names (compensation mode): COMPU_VTAB entries i → names[i].
+  /// A characteristic whose values are names (compensation mode): COMPU_VTAB entries i → names[i];
+  /// a write must then be an integer (a fraction is refused with ERR_OUT_OF_RANGE).
   std::vector<std::string> names;
 };
 

@@ -56,6 +56,8 @@ struct AdaptationSettings {
   double tolerance_ratio = 0.08;
   /// Throws std::invalid_argument naming the field.
   void validate() const;
+  /// The same checks as validate(), without an exception (real time: calibration writes).
+  bool valid() const noexcept;
 };
 
 /// Why the inverse holds the values it holds (the compensator's own verdict).
@@ -83,6 +85,12 @@ class ParameterGate {
   AdaptationReason reason() const noexcept { return reason_; }
   /// Samples on which the value changed.
   std::uint64_t changes() const noexcept { return changes_; }
+  /// Calibration (between samples; s valid): new ρ, ratios, dead band, settle and hold times.
+  /// The value, the nominal value and the timers' counts are kept (a settle or hold already
+  /// longer than the new time ends on the next sample).
+  void retune(const AdaptationSettings& s, double dt_s) noexcept;
+  /// Calibration: starts over at `nominal` (value = nominal, never adapted, timers cleared).
+  void restart(double nominal, const AdaptationSettings& s, double dt_s) noexcept;
 
  private:
   double nominal_, value_, max_step_, lo_, hi_, tol_;
@@ -97,6 +105,10 @@ class ParameterGate {
 class Dither {
  public:
   Dither(double amplitude, double period_s, double dt_s) noexcept;
+  /// Calibration: new amplitude and period; the phase is kept (wrapped into the new period).
+  void retune(double amplitude, double period_s, double dt_s) noexcept;
+  /// Calibration: the next step() starts a period (+A).
+  void restart() noexcept { k_ = 0; }
   double step() noexcept {
     if (amplitude_ == 0.0) return 0.0;
     const double out = k_ < half_ ? amplitude_ : -amplitude_;
@@ -164,7 +176,11 @@ struct CompensationConfig {
 ///   - refine(Side, AdaptationReason) noexcept, the adapter's own refusal (e.g. not_excited);
 ///   - reason(Side) noexcept -> const char*, why a side is (not) used;
 ///   - identified(Side) noexcept, the estimator's own verdict on a side;
-///   - estimator() -> const Estimator&.
+///   - estimator() -> const Estimator&;
+///   - static with_nominal(Params, double right, double left) noexcept -> Params, the nominal
+///     parameters with the gates' two replaced (calibration);
+///   - retune(const CompensationConfig<Adapter>&) noexcept, new nominal or adaptation settings
+///     (calibration; the estimator is kept).
 /// command() and observe() are noexcept, O(1) and allocation-free.
 /// Stale samples (observe(…, fresh = false)) neither update the estimator nor move the inverse.
 template <class Inverse, class Adapter>
@@ -254,7 +270,59 @@ class Compensator {
   }
   const Config& config() const noexcept { return cfg_; }
 
+  // Calibration (docs/xcp.md): noexcept, O(1), allocation-free; called between samples (the
+  // master's step boundary, before the next command()). A value outside its domain is refused
+  // (false) and nothing changes.
+
+  /// Switches the mode. A change restarts the compensation from the nominal inverse: the
+  /// inverse and both gates return to the nominal parameters (adapted values dropped, settle and
+  /// hold timers cleared), the dither starts a new period, and the estimator is restarted as
+  /// after a gap (Adapter::restart(): its estimates and verdict are kept, its delayed samples
+  /// are not; it was not stepped outside adaptive). The same mode: nothing changes.
+  bool set_mode(CompensationMode m) noexcept {
+    if (m != CompensationMode::none && m != CompensationMode::fixed && m != CompensationMode::adaptive) return false;
+    if (m == cfg_.mode) return true;
+    cfg_.mode = m;
+    restart_from_nominal();
+    adapter_.restart();
+    return true;
+  }
+  /// New nominal inverse parameters (Adapter::nominal's two: the valve's edges c_r and −c_l as
+  /// magnitudes ≥ 0 [mA]; the carts' gaps ≥ 0): the fixed inverse, and the start of the
+  /// adaptive one. Takes effect at once in every mode (a jump, not rate-limited: as a new
+  /// fixed inverse); in adaptive the gates start over at the new values (adapted values
+  /// dropped, settle timers cleared); the estimator is not touched.
+  bool set_nominal(double right, double left) noexcept {
+    if (!(right >= 0.0 && right < 1e300 && left >= 0.0 && left < 1e300)) return false;
+    cfg_.nominal = Adapter::with_nominal(cfg_.nominal, right, left);
+    adapter_.retune(cfg_);
+    restart_from_nominal();
+    return true;
+  }
+  /// New adaptation settings (s.valid()): the gates' ρ, ratios, dead band, settle and hold
+  /// times, the dither's amplitude and period, the excitation threshold. The inverse's values,
+  /// the gates' timers and the estimator are kept: a change of tuning, not a restart.
+  bool set_adaptation(const AdaptationSettings& s) noexcept {
+    if (!s.valid()) return false;
+    cfg_.adaptation = s;
+    const double dt = cfg_.estimator.dt_s;
+    gate_r_.retune(s, dt);
+    gate_l_.retune(s, dt);
+    dither_.retune(s.dither_amplitude, s.dither_period_s, dt);
+    adapter_.retune(cfg_);
+    return true;
+  }
+
  private:
+  void restart_from_nominal() noexcept {
+    const PerSide<double> n = Adapter::nominal(cfg_.nominal);
+    const double dt = cfg_.estimator.dt_s;
+    gate_r_.restart(n.right, cfg_.adaptation, dt);
+    gate_l_.restart(n.left, cfg_.adaptation, dt);
+    inv_.set_params(cfg_.nominal);
+    dither_.restart();
+  }
+
   Config cfg_;
   Inverse inv_;
   Adapter adapter_;
@@ -274,6 +342,11 @@ class DeadzoneAdapter {
   /// The model must be input_deadzone.
   static void validate(const EstimatorConfig& e);
   static PerSide<double> nominal(const Params& p) noexcept { return {p.offset_right, p.offset_left}; }
+  static Params with_nominal(Params p, double right, double left) noexcept {
+    p.offset_right = right;
+    p.offset_left = left;
+    return p;
+  }
   static void apply(DeadzoneInverse& inv, double right, double left, const Params&) noexcept {
     inv.set_offsets(right, left);
   }
@@ -282,6 +355,11 @@ class DeadzoneAdapter {
     return {inv.params().offset_right, -inv.params().offset_left};
   }
   explicit DeadzoneAdapter(const CompensationConfig<DeadzoneAdapter>& c);
+  /// Calibration: the excitation threshold follows the nominal edges and min_excitation_ratio.
+  void retune(const CompensationConfig<DeadzoneAdapter>& c) noexcept {
+    need_ = {c.adaptation.min_excitation_ratio * c.nominal.offset_right,
+             c.adaptation.min_excitation_ratio * c.nominal.offset_left};
+  }
   PerSide<GateInput> step(double v_applied, double y) noexcept;
   /// A gap: the estimator's restart(); the excitation record skips the samples the estimator
   /// does not update on (its warm-up), as it skips those inside the guesses.
@@ -338,6 +416,12 @@ class BacklashAdapter {
   /// The model must be deadzone_deadband, input_shift > 0 and the guesses beyond ±input_shift.
   static void validate(const BacklashEstimatorConfig& e) { e.validate(); }
   static PerSide<double> nominal(const Params& p) noexcept { return {p.right, p.left}; }
+  static Params with_nominal(Params p, double right, double left) noexcept {
+    p.right = right;
+    p.left = left;
+    return p;
+  }
+  void retune(const CompensationConfig<BacklashAdapter>&) noexcept {}
   static void apply(BacklashInverse& inv, double right, double left, const Params& nominal) noexcept {
     inv.set_params({right, left, nominal.smoothing});
   }

@@ -26,9 +26,14 @@ struct CalibrationPage {
   double ki_per_s = 0.0;              ///< PID integral gain [mA/(kPa s)]
   double kd_s = 0.0;                  ///< PID derivative gain [mA s/kPa]
   double n_per_s = 0.0;               ///< PID derivative filter [1/s]; 0 = unfiltered
-  double dz_right_mA = 0.0;           ///< the deadzone inverse's nominal right edge [mA] (bench controller)
-  double dz_left_mA = 0.0;            ///< the deadzone inverse's nominal left edge, magnitude [mA] (bench controller)
+  double dz_right_mA = 0.0;           ///< the deadzone inverse's nominal right edge c_r [mA]
+  double dz_left_mA = 0.0;            ///< the deadzone inverse's nominal left edge, magnitude |c_l| [mA]
   double reference_offset_kPa = 0.0;  ///< added to the reference r(m) [kPa]
+  double compensation = 1.0;          ///< CompensationMode as a number: 0 none, 1 fixed, 2 adaptive
+  double adapt_rate_mA_per_s = 100.0; ///< AdaptationSettings::rate_limit_per_s ρ [mA/s] (scenario law)
+  double adapt_tolerance = 0.08;      ///< AdaptationSettings::tolerance_ratio, the dead band [-] (scenario law)
+  double adapt_settle_s = 0.5;        ///< AdaptationSettings::settle_s [s] (scenario law)
+  double dither_mA = 0.0;             ///< AdaptationSettings::dither_amplitude A [mA] (scenario law)
   bool operator==(const CalibrationPage&) const = default;
 };
 
@@ -39,6 +44,9 @@ struct CalibrationField {
   const char* unit;
   double min, max;    ///< A2L limits; XCP writes outside are refused with ERR_OUT_OF_RANGE
   const char* doc;
+  /// Named values (A2L COMPU_METHOD TAB_VERB, value i ↔ names[i]); the value must then be an
+  /// integer in [min, max] (XCP refuses a fraction with ERR_OUT_OF_RANGE). Empty: a number.
+  std::span<const char* const> names;
 };
 std::span<const CalibrationField> calibration_fields() noexcept;
 const CalibrationField* find_calibration_field(std::string_view name) noexcept;
