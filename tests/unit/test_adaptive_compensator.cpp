@@ -311,3 +311,29 @@ TEST(CompensatorCalibration, AdaptedValuesDroppedOnAModeSwitch) {
   EXPECT_EQ(comp.gate(Side::right).value(), 0.005);
   EXPECT_EQ(comp.reason(), AdaptationReason::nominal);
 }
+
+// Switched to adaptive before its first sample, a compensator equals one built adaptive (the
+// estimator is not restarted: nothing to clear), sample for sample; so does one switched
+// adaptive -> fixed -> adaptive with no sample between (the master's replay applies such pages
+// as the last one alone).
+TEST(CompensatorCalibration, SwitchesBeforeTheFirstSampleEqualTheLastAlone) {
+  // The valve: v beyond the right guess (432 mA) from the first sample, y = v − 288 (+ a first-order
+  // lag), so the estimator updates from its first samples (a restart's warm-up would show).
+  DeadzoneCompensator built(valve(CompensationMode::adaptive)), switched(valve(CompensationMode::fixed)),
+      twice(valve(CompensationMode::adaptive));
+  ASSERT_TRUE(switched.set_mode(CompensationMode::adaptive));
+  ASSERT_TRUE(twice.set_mode(CompensationMode::fixed));
+  ASSERT_TRUE(twice.set_mode(CompensationMode::adaptive));
+  double y = 0.0;
+  for (int k = 0; k < 400; ++k) {
+    const double v = 700.0 + 200.0 * std::sin(0.05 * k);
+    y = 0.9 * y + 0.1 * (v - 288.0);
+    built.observe(v, y, true);
+    switched.observe(v, y, true);
+    twice.observe(v, y, true);
+    const double c = built.estimator().params(Side::right).c;
+    ASSERT_EQ(std::bit_cast<std::uint64_t>(switched.estimator().params(Side::right).c), std::bit_cast<std::uint64_t>(c)) << k;
+    ASSERT_EQ(std::bit_cast<std::uint64_t>(twice.estimator().params(Side::right).c), std::bit_cast<std::uint64_t>(c)) << k;
+  }
+  EXPECT_TRUE(std::isfinite(built.estimator().params(Side::right).c));  // it did update
+}

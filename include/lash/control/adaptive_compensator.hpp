@@ -230,9 +230,11 @@ class Compensator {
     if (cfg_.mode != CompensationMode::adaptive) return;
     if (!fresh) {
       adapter_.restart();
+      stepped_ = false;
       ++stale_;
       return;
     }
+    stepped_ = true;
     const PerSide<GateInput> e = adapter_.step(a, b);
     const double old_r = gate_r_.value(), old_l = gate_l_.value();
     const double r = gate_r_.step(e.right.ok, e.right.value);
@@ -278,13 +280,17 @@ class Compensator {
   /// inverse and both gates return to the nominal parameters (adapted values dropped, settle and
   /// hold timers cleared), the dither starts a new period, and the estimator is restarted as
   /// after a gap (Adapter::restart(): its estimates and verdict are kept, its delayed samples
-  /// are not; it was not stepped outside adaptive). The same mode: nothing changes.
+  /// are not; it was not stepped outside adaptive) — unless it has not been stepped since it was
+  /// built or last restarted (then it is left as it is: a compensator switched to adaptive before
+  /// its first sample equals one built adaptive, and switches with no sample between them act
+  /// as the last one alone). The same mode: nothing changes.
   bool set_mode(CompensationMode m) noexcept {
     if (m != CompensationMode::none && m != CompensationMode::fixed && m != CompensationMode::adaptive) return false;
     if (m == cfg_.mode) return true;
     cfg_.mode = m;
     restart_from_nominal();
-    adapter_.restart();
+    if (stepped_) adapter_.restart();
+    stepped_ = false;
     return true;
   }
   /// New nominal inverse parameters (Adapter::nominal's two: the valve's edges c_r and −c_l as
@@ -329,6 +335,7 @@ class Compensator {
   ParameterGate gate_r_, gate_l_;
   Dither dither_;
   std::uint64_t updates_ = 0, stale_ = 0;
+  bool stepped_ = false;  ///< the adapter was stepped since it was built or last restarted
 };
 
 /// Input deadzone (pilot valve): InputDeadzoneEstimator on (v(k) as applied, y(k)) → the edges
