@@ -251,6 +251,9 @@ class Parser {
     check_unterminated();
   }
 
+  /// Keyword statements read without error (VERSION, BU_, BO_, ...): 0 means no DBC at all.
+  std::size_t statements_read() const noexcept { return statements_read_; }
+
   Database run() {
     while (tok_.kind != Tok::end) guarded_statement();
     resolve();
@@ -349,6 +352,7 @@ class Parser {
     const Token kw = tok_;
     try {
       statement();
+      if (kw.kind == Tok::ident && is_keyword(kw.text)) ++statements_read_;
     } catch (const InputError&) {
       if (strict_) throw;
       // Report the statement's first problem and skip to the next statement.
@@ -909,6 +913,7 @@ class Parser {
   Database db_;
   std::string file_;
   bool strict_ = false;
+  std::size_t statements_read_ = 0;
   std::vector<Diagnostic>* diags_ = nullptr;
   std::string what_ = "DBC";
   int prev_line_ = 0;
@@ -927,8 +932,8 @@ Database parse_dbc(std::string_view text, const std::string& file, const ParseOp
   const std::size_t before = diags->size();
   Parser p(text, file, options, diags);
   Database db = p.run();
-  // Tolerant reading keeps what it can; when that is nothing at all, the file is no DBC.
-  if (db == Database{} && diags->size() > before)
+  // Tolerant reading keeps what it can; when not one statement could be read, the file is no DBC.
+  if (p.statements_read() == 0 && diags->size() > before)
     throw InputError(file, 0, "",
                      fmt::format("no DBC statement could be read ({} problems, e.g. line {}: {}): not a DBC file?",
                                  diags->size() - before, (*diags)[before].line, (*diags)[before].message));

@@ -141,7 +141,12 @@ with tempfile.TemporaryDirectory() as tmp:
         time.sleep(10)
         f1 = d.execute_script("return window.lashStats.frames")
         fps = (f1 - f0) / 10.0
-        drops = d.find_element(By.CSS_SELECTOR, '[data-status="drops"]').text
+        # read in one script call: the status panel is redrawn as it updates, so a found element
+        # can be replaced before its text is asked for (StaleElementReferenceException)
+        drops = d.execute_script("const e = document.querySelector('[data-status=\"drops\"]');"
+                                 " return e ? e.textContent : null;")
+        if drops is None or not drops.strip().isdigit():
+            fail(f"the status panel's drop counter shows {drops!r}")
         print(f"page: {fps:.1f} frames/s (requestAnimationFrame over 10 s); drops {drops}")
         if os.environ.get("LASH_CONSOLE_SHOT"):
             d.save_screenshot(os.environ["LASH_CONSOLE_SHOT"])

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "lash/can/codec.hpp"
 #include "lash/can/dbc.hpp"
@@ -287,4 +288,17 @@ BA_ "SystemEnvVarLongSymbol" EV_ EnvVar_12345678901234567890123456 "EnvVar_12345
   EXPECT_TRUE(env);
   // written and read back: the same database (the long names are a fixed point)
   EXPECT_EQ(parse_dbc(write_dbc(db)), db);
+}
+
+// Tolerant reading keeps what it can, but a file in which not one statement could be read is
+// no DBC (exit 2), while a file of valid but empty statements is one. The second text is the
+// fuzzer's: its verbatim statement's open quote swallows the next statement when written back,
+// and the written text must still load.
+TEST(CanDbc, NothingReadIsNoDbcButEmptyStatementsAre) {
+  std::vector<Diagnostic> diags;
+  EXPECT_THROW(parse_dbc(std::string("\x01\x02 garbage\n\xff\xfe;\n", 14), "g.dbc", {}, &diags), lash::InputError);
+  EXPECT_NO_THROW(parse_dbc("VERSION \"\"\nBU_:\n"));
+  const Database db = parse_dbc("CM_\"s\";CM_\nSG_ 6 S\"\n", "f.dbc", {}, &diags);
+  EXPECT_EQ(db.comment, "s");
+  EXPECT_NO_THROW(parse_dbc(write_dbc(db), "written.dbc", {}, &diags));
 }
