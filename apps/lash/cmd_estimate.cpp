@@ -1,15 +1,19 @@
 // lash estimate: run one of the switching estimators of docs/method.md §A4 over a recorded t,v,y file.
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <map>
+#include <optional>
+#include <set>
 
-#include <unistd.h>
 
 #include <fmt/core.h>
 
 #include "cli_common.hpp"
 #include "estimate_plot.hpp"
 #include "estimate_settings.hpp"
+#include "plot.hpp"
 #include "lash/identify/any_estimator.hpp"
 #include "lash/identify/auto.hpp"
 #include "lash/identify/estimate.hpp"
@@ -64,6 +68,12 @@ int run(const CLI::App& sub, const EstimateOptions& o) {
     fmt::print("{}", config_to_toml(e.run.cfg, &e.job));
     return kExitOk;
   }
+  // the result first: a failing -o or --plot never hides it
+  if (o.json)
+    fmt::print("{}\n", e.json);
+  else
+    fmt::print("{}", estimate_auto_text(e.run, e.result.dt_s, e.fit));
+  std::fflush(stdout);
   // the trace: t, y, yhat, y_sim and every parameter per step
   std::vector<std::string> names{"t", "y", "yhat", "y_sim"};
   std::vector<const std::vector<double>*> cols{&t, &rec.y(), &run.yhat, &run.ysim};
@@ -73,29 +83,23 @@ int run(const CLI::App& sub, const EstimateOptions& o) {
   }
   if (!o.out.empty()) write_columns_csv(o.out, names, cols);
   if (!o.plot.empty()) {
+    std::set<std::string> empty;  // columns without a finite value: a side never identified
+    for (std::size_t p = 0; p < run.param_names.size(); ++p)
+      if (std::none_of(run.params[p].begin(), run.params[p].end(), [](double x) { return std::isfinite(x); }))
+        empty.insert(run.param_names[p]);
     std::string csv = o.out;
-    std::filesystem::path tmp;
+    std::optional<PrivateTempDir> tmp;  // without -o: the trace in a fresh private directory (mkdtemp)
     if (csv.empty()) {
-      tmp = std::filesystem::temp_directory_path() / ("lash-estimate-" + std::to_string(::getpid()) + ".csv");
-      csv = tmp.string();
+      tmp.emplace(o.plot, "--plot");
+      csv = (tmp->path() / "trace.csv").string();
       write_columns_csv(csv, names, cols);
     }
-    try {
-      plot_estimate(csv, o.plot,
-                    fmt::format("lash estimate --model {} {}", to_string(e.run.cfg.model),
-                                std::filesystem::path(o.data).filename().string()),
-                    run.param_names, t.back(), ci95_columns(run.report));
-    } catch (...) {
-      if (!tmp.empty()) std::filesystem::remove(tmp);
-      throw;
-    }
-    if (!tmp.empty()) std::filesystem::remove(tmp);
+    plot_estimate(csv, o.plot,
+                  fmt::format("lash estimate --model {} {}", to_string(e.run.cfg.model),
+                              std::filesystem::path(o.data).filename().string()),
+                  run.param_names, t.back(), ci95_columns(run.report), empty);
   }
 
-  if (o.json)
-    fmt::print("{}\n", e.json);
-  else
-    fmt::print("{}", estimate_auto_text(e.run, e.result.dt_s, e.fit));
   return kExitOk;
 }
 

@@ -1,5 +1,7 @@
 #include "estimate_plot.hpp"
 
+#include <algorithm>
+
 #include <fmt/core.h>
 
 #include "plot.hpp"
@@ -26,7 +28,8 @@ std::string side_title(const std::string& col) {
 
 void plot_estimate(const std::string& csv, const std::string& png, const std::string& title,
                    const std::vector<std::string>& param_names, double t_end_s,
-                   const std::map<std::string, std::pair<double, double>>& ci95) {
+                   const std::map<std::string, std::pair<double, double>>& ci95,
+                   const std::set<std::string>& empty_columns) {
   std::vector<Panel> panels;
   for (const auto& n : param_names) {
     const std::string base = n.substr(0, n.find('_'));
@@ -62,7 +65,15 @@ void plot_estimate(const std::string& csv, const std::string& png, const std::st
       plot += fmt::format("'{}' using (column('t')):(column('{}')) with lines lw 1.5 lc rgb '{}' title '{}'", csv,
                           p.columns[i], colors[i % 2], side_title(p.columns[i]));
     }
+    // gnuplot cannot autoscale a panel with no defined point: fixed axes and a note instead
+    const bool none = std::all_of(p.columns.begin(), p.columns.end(),
+                                  [&](const std::string& c) { return empty_columns.count(c) > 0; });
+    if (none)
+      s += fmt::format("set xrange [0:{:.17g}]\nset yrange [-1:1]\nset label 1 'not identified: no estimate of {}' "
+                       "at graph 0.5, graph 0.5 center\n",
+                       t_end_s > 0 ? t_end_s : 1.0, p.base);
     s += plot + "\n";
+    if (none) s += "unset label 1\nset autoscale x\nset autoscale y\n";
     for (int k = 1; k <= obj; ++k) s += fmt::format("unset object {}\n", k);
   }
   s += fmt::format("set xlabel 't [s] (last {:g} s)'\nset ylabel 'output y [y unit]'\nset xrange [{}:{}]\n",

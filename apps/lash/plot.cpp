@@ -18,27 +18,30 @@
 
 namespace lash::cli {
 
-void run_gnuplot(const std::string& script_in, const std::string& png_path) {
+PrivateTempDir::PrivateTempDir(const std::string& target, const std::string& option) {
   const std::filesystem::path dir =
-      std::filesystem::path(png_path).has_parent_path() ? std::filesystem::path(png_path).parent_path() : ".";
+      std::filesystem::path(target).has_parent_path() ? std::filesystem::path(target).parent_path() : ".";
   std::error_code dec;
   if (!std::filesystem::is_directory(dir, dec))
-    throw InputError(png_path, 0, "--plot", "cannot write: directory " + dir.string() + " does not exist");
+    throw InputError(target, 0, option, "cannot write: directory " + dir.string() + " does not exist");
   if (::access(dir.c_str(), W_OK) != 0)
-    throw InputError(png_path, 0, "--plot", "cannot write in directory " + dir.string() + ": " + std::strerror(errno));
-  // gnuplot's script and picture go to a fresh private directory next to the target (mkdtemp:
-  // created exclusively, mode 0700), so nothing planted at a predictable name is followed.
-  std::string dir_template = png_path + ".tmp.XXXXXX";
+    throw InputError(target, 0, option, "cannot write in directory " + dir.string() + ": " + std::strerror(errno));
+  std::string dir_template = target + ".tmp.XXXXXX";
   if (!::mkdtemp(dir_template.data()))
-    throw InputError(png_path, 0, "--plot", "cannot create a temporary directory next to it: " + std::string(std::strerror(errno)));
-  const std::filesystem::path work(dir_template);
-  struct RemoveDir {
-    std::filesystem::path d;
-    ~RemoveDir() {
-      std::error_code e;
-      std::filesystem::remove_all(d, e);
-    }
-  } cleanup{work};
+    throw InputError(target, 0, option,
+                     "cannot create a temporary directory next to it: " + std::string(std::strerror(errno)));
+  dir_ = dir_template;
+}
+
+PrivateTempDir::~PrivateTempDir() {
+  std::error_code e;
+  std::filesystem::remove_all(dir_, e);
+}
+
+void run_gnuplot(const std::string& script_in, const std::string& png_path) {
+  // gnuplot's script and picture go to a fresh private directory next to the target
+  const PrivateTempDir tmp(png_path, "--plot");
+  const std::filesystem::path& work = tmp.path();
   const std::string tmp_png = (work / "plot.png").string();
   std::string script = script_in;
   for (auto pos = script.find("<OUTPUT>"); pos != std::string::npos; pos = script.find("<OUTPUT>"))

@@ -52,7 +52,10 @@ void require(bool ok, const char* field, const std::string& msg) {
 
 void CommonSettings::validate() const {
   require(std::isfinite(dt_s) && dt_s > 0, "dt", "sample period must be > 0 [s]");
-  require(rls.lambda > 0 && rls.lambda <= 1, "lambda", "forgetting factor must be in (0, 1]");
+  // λ < 0.9 remembers fewer than 1/(1 − λ) = 10 samples: too few to separate a side's 3–4
+  // parameters from noise, and a forgetting factor like 1e-300 makes the RLS denominators vanish
+  require(rls.lambda >= kMinLambda && rls.lambda <= 1, "lambda",
+          "forgetting factor must be in [0.9, 1] (a memory 1/(1 - lambda) of at least 10 samples)");
   require(std::isfinite(rls.p0) && rls.p0 > 0, "p0", "initial covariance must be > 0");
   require(rls.trace_max > 0, "trace-max", "must be > 0");
   for (std::size_t i = 0; i < 3; ++i) {

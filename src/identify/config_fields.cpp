@@ -75,7 +75,7 @@ const ConfigField kFields[] = {
   {"", "fit_start", "", "Start of the verdict's fit window [s]", kCommon,
    [](C& c) -> Ref { return &c.fit_start_s; }},
   // CommonSettings::rls
-  {"rls", "lambda", "lambda", "Forgetting factor in (0, 1] (thesis: 0.99)", kCommon,
+  {"rls", "lambda", "lambda", "Forgetting factor in [0.9, 1] (thesis: 0.99)", kCommon,
    [](C& c) -> Ref { return &c.rls.lambda; }},
   {"rls", "p0", "p0", "Initial covariance P0 = p0 I (thesis: 1000)", kCommon,
    [](C& c) -> Ref { return &c.rls.p0; }},

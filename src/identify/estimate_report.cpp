@@ -68,6 +68,7 @@ std::string estimate_json(const EstimateReport& r, const ReportFit& fit) {
   j["nrmse_pct"] = num(100.0 * fit.nrmse);
   j["nrmse_window_s"] = {fit.t0_s, fit.t1_s};
   j["rows_skipped"] = fit.rows_skipped;
+  j["samples_skipped"] = r.skipped;  // the text's "N skipped"
   j["gaps"] = fit.gaps;
   return j.dump();
 }

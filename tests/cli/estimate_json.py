@@ -79,6 +79,25 @@ with tempfile.TemporaryDirectory() as d:
     check(j["left"]["identified"] is False and j["left"]["c"] is None and j["left"]["a1"] is None,
           f"left never updated -> null: {j['left']}")
     check(j["left"]["reason"] == "not_updated", f"left reason {j['left']['reason']}")
+    # --plot of that run: the never-identified side is a panel saying so, not a gnuplot failure;
+    # the result is printed whatever the plot does
+    png = os.path.join(d, "one-sided.png")
+    r = subprocess.run([LASH, "estimate", "--model", "input-deadzone", "--guess-left", "-700", "--guess-right", "350",
+                        data, "--json", "--plot", png], capture_output=True, text=True)
+    check(r.returncode == 0 and os.path.getsize(png) > 10000 and json.loads(r.stdout)["left"]["identified"] is False,
+          f"--plot with a side never identified: exit {r.returncode}, {r.stderr.strip()[:200]}")
+    check(not [n for n in os.listdir(d) if ".tmp." in n], f"no temporary left: {os.listdir(d)}")
+    # every count the text prints is in the JSON: "N skipped" = samples_skipped
+    args = [LASH, "estimate", "--model", "deadzone-deadband", data]
+    text = subprocess.run(args, capture_output=True, text=True).stdout
+    jj = json.loads(subprocess.run(args + ["--json"], capture_output=True, text=True).stdout)
+    first = text.splitlines()[0] if text else ""
+    check(first.endswith(f", {jj.get('samples_skipped')} skipped"), f"samples_skipped {jj.get('samples_skipped')} "
+          f"is the text's '{first}'")
+    # a forgetting factor that cannot work is refused, naming the key and its range
+    r = subprocess.run(args + ["--lambda", "1e-300"], capture_output=True, text=True)
+    check(r.returncode == 2 and "lambda" in r.stderr and "[0.9, 1]" in r.stderr and not r.stdout,
+          f"--lambda 1e-300: exit {r.returncode}, {r.stderr.strip()[:200]}")
     # renamed columns + config file
     cfg = os.path.join(d, "est.toml")
     with open(cfg, "w") as f:

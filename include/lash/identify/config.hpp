@@ -35,8 +35,11 @@ const char* to_string(Forgetting f) noexcept;
 
 /// Settings of every RLS inside an estimator (thesis §1.5.1: λ = 0.99, P0 = 1000·I, η0 = [1 1 1]).
 /// Parameter order is [a1, b1, e] (docs/method.md §A4); the linear model uses the first two.
+/// The smallest forgetting factor an estimator accepts: a memory 1/(1 − λ) of 10 samples.
+inline constexpr double kMinLambda = 0.9;
+
 struct RlsSettings {
-  double lambda = 0.99;
+  double lambda = 0.99;  ///< [kMinLambda, 1]
   double p0 = 1000.0;
   std::array<double, 3> eta0{1.0, 1.0, 1.0};
   Forgetting forgetting = Forgetting::exponential;
