@@ -10,6 +10,7 @@
 
 #include "lash/io/atomic_file.hpp"
 #include "lash/io/error.hpp"
+#include "lash/can/log_reader.hpp"
 #include "log_formats.hpp"
 
 namespace lash::can {
@@ -381,33 +382,30 @@ std::string format_log_line(const Frame& frame, std::string_view interface) {
                      format_frame_text(frame));
 }
 
-std::vector<LogEntry> parse_log(std::string_view text, const std::string& file, LogReadReport* report) {
-  std::vector<LogEntry> out;
-  int lineno = 0;
-  std::size_t pos = 0;
-  while (pos <= text.size()) {
-    auto nl = text.find('\n', pos);
-    if (nl == std::string_view::npos) nl = text.size();
-    const std::string_view line = text.substr(pos, nl - pos);
-    ++lineno;
-    pos = nl + 1;
-    if (line.find_first_not_of(" \t\r") == std::string_view::npos) {
-      if (nl == text.size()) break;
-      continue;
-    }
-    std::string error;
-    auto e = parse_log_line(line, error);
-    if (e && !e->frame.valid()) {
-      error = "invalid frame";
-      e.reset();
-    }
-    if (!e) {
-      detail::drop(report, file, lineno, "candump line", error);
-    } else {
-      out.push_back(std::move(*e));
-    }
-    if (nl == text.size()) break;
+namespace detail {
+
+bool candump_line(std::string_view line, long lineno, const std::string& file, LogReadReport* report, LogEntry& out) {
+  if (line.find_first_not_of(" \t\r") == std::string_view::npos) return false;
+  std::string error;
+  auto e = parse_log_line(line, error);
+  if (e && !e->frame.valid()) {
+    error = "invalid frame";
+    e.reset();
   }
+  if (!e) {
+    drop(report, file, lineno, "candump line", error);
+    return false;
+  }
+  out = std::move(*e);
+  return true;
+}
+
+}  // namespace detail
+
+std::vector<LogEntry> parse_log(std::string_view text, const std::string& file, LogReadReport* report) {
+  LogReader r(text, LogFormat::candump, file, report);
+  std::vector<LogEntry> out;
+  for (LogEntry e; r.next(e);) out.push_back(e);
   return out;
 }
 
@@ -429,22 +427,11 @@ const char* to_string(LogFormat f) noexcept {
   }
 }
 
-std::string read_file_bytes(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string(), 0, "", "cannot open log file for reading");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 std::vector<LogEntry> read_log(const std::filesystem::path& path, LogReadReport* report) {
-  const std::string bytes = read_file_bytes(path);
-  switch (log_format_of(path)) {
-    case LogFormat::asc: return detail::parse_asc(bytes, path.string(), report);
-    case LogFormat::blf: return detail::parse_blf(bytes, path.string(), report);
-    case LogFormat::trc: return detail::parse_trc(bytes, path.string(), report);
-    default: return parse_log(bytes, path.string(), report);
-  }
+  LogReader r(path, report);
+  std::vector<LogEntry> out;
+  for (LogEntry e; r.next(e);) out.push_back(e);
+  return out;
 }
 
 TimeSpan writable_times(LogFormat format) noexcept {
@@ -462,39 +449,47 @@ TimeSpan writable_times(LogFormat format) noexcept {
   }
 }
 
+namespace detail {
+
+TimeCheck::TimeCheck(LogFormat format, const LogTimes& times, std::string file)
+    : format_(format), span_(writable_times(format)), t0_(times.earliest_s), origin_(0.0), file_(std::move(file)) {
+  // BLF writes offsets from its header's start, the others from the earliest frame.
+  const bool t0_ok = std::isfinite(t0_) && t0_ >= span_.min_abs_s && t0_ < span_.max_abs_s;
+  origin_ = format == LogFormat::blf ? (t0_ok ? blf_start_of(t0_) : 0.0) : t0_;
+}
+
+void TimeCheck::check(double t, std::uint64_t index) const {
+  const double offset = t - origin_;
+  const char* why = nullptr;
+  if (!std::isfinite(t)) why = "is not a finite number";
+  else if (t < span_.min_abs_s || t >= span_.max_abs_s) why = "is outside the times the format can hold";
+  else if (!(offset < span_.max_offset_s) || !std::isfinite(offset)) why = "lies too far from the log's earliest frame";
+  if (why)
+    throw InputError(file_, 0, fmt::format("frame {}", index + 1),
+                     fmt::format("timestamp {} s {} for {} (times from {} s to {} s, at most {} s after the earliest frame at {} s); "
+                                 "nothing written",
+                                 t, why, to_string(format_), span_.min_abs_s, span_.max_abs_s, span_.max_offset_s, t0_));
+}
+
+}  // namespace detail
+
 void check_writable_times(const std::vector<LogEntry>& entries, LogFormat format, const std::string& file) {
   if (entries.empty()) return;
-  const TimeSpan span = writable_times(format);
-  double t0 = entries.front().frame.timestamp_s;
-  for (const auto& e : entries) t0 = std::min(t0, e.frame.timestamp_s);
-  // BLF writes offsets from its header's start, the others from the earliest frame.
-  const bool t0_ok = std::isfinite(t0) && t0 >= span.min_abs_s && t0 < span.max_abs_s;
-  const double origin = format == LogFormat::blf ? (t0_ok ? detail::blf_start_of(t0) : 0.0) : t0;
-  for (std::size_t i = 0; i < entries.size(); ++i) {
-    const double t = entries[i].frame.timestamp_s;
-    const double offset = t - origin;
-    const char* why = nullptr;
-    if (!std::isfinite(t)) why = "is not a finite number";
-    else if (t < span.min_abs_s || t >= span.max_abs_s) why = "is outside the times the format can hold";
-    else if (!(offset < span.max_offset_s) || !std::isfinite(offset)) why = "lies too far from the log's earliest frame";
-    if (why)
-      throw InputError(file, 0, fmt::format("frame {}", i + 1),
-                       fmt::format("timestamp {} s {} for {} (times from {} s to {} s, at most {} s after the earliest frame at {} s); "
-                                   "nothing written",
-                                   t, why, to_string(format), span.min_abs_s, span.max_abs_s, span.max_offset_s, t0));
-  }
+  LogTimes times;
+  for (const auto& e : entries) times.add(e.frame.timestamp_s);
+  const detail::TimeCheck check(format, times, file);
+  for (std::size_t i = 0; i < entries.size(); ++i) check.check(entries[i].frame.timestamp_s, i);
 }
 
 void write_log(const std::filesystem::path& path, const std::vector<LogEntry>& entries) {
-  check_writable_times(entries, log_format_of(path), path.string());
+  const LogFormat format = log_format_of(path);
+  check_writable_times(entries, format, path.string());
+  LogTimes times;
+  for (const auto& e : entries) times.add(e.frame.timestamp_s);
   AtomicFile f(path);
-  switch (log_format_of(path)) {
-    case LogFormat::asc: detail::write_asc(f.stream(), entries); break;
-    case LogFormat::blf: detail::write_blf(f.stream(), entries); break;
-    case LogFormat::trc: detail::write_trc(f.stream(), entries); break;
-    default:
-      for (const auto& e : entries) f.stream() << format_log_line(e.frame, e.interface) << '\n';
-  }
+  LogWriter w(f.stream(), format, times, path.string());
+  for (const auto& e : entries) w.write(e);
+  w.finish();
   f.commit();
 }
 
