@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -382,10 +383,67 @@ std::string format_log_line(const Frame& frame, std::string_view interface) {
                      format_frame_text(frame));
 }
 
+namespace {
+
+/// The common candump -L line `(seconds.fraction) iface ID#HEX` of a classic data frame, parsed
+/// straight into `out` (its interface string reused): true when the line is of that form, false
+/// (nothing decided) otherwise; parse_log_line then reads it, with its messages. For the lines it
+/// takes, the result is parse_log_line's.
+bool fast_log_line(std::string_view s, LogEntry& out) {
+  while (!s.empty() && (s.back() == '\r' || s.back() == '\n' || s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
+  if (s.size() < 3 || s[0] != '(') return false;
+  const auto blank = [](char c) { return c == ' ' || c == '\t'; };  // (find_first_of calls memchr per character)
+  std::size_t close = 1;
+  while (close < s.size() && s[close] != ')') {
+    if (blank(s[close])) return false;
+    ++close;
+  }
+  if (close < 2 || close + 2 >= s.size() || s[close + 1] != ' ') return false;
+  const std::string_view ts = s.substr(1, close - 1);
+  std::size_t i = close + 2;
+  std::size_t j = i;
+  while (j < s.size() && !blank(s[j])) ++j;
+  if (j == i || j >= s.size() || s[j] != ' ') return false;
+  const std::string_view iface = s.substr(i, j - i);
+  const std::string_view text = s.substr(j + 1);
+  std::size_t hash = std::string_view::npos;
+  for (std::size_t k = 0; k < text.size(); ++k) {
+    if (blank(text[k])) return false;
+    if (text[k] == '#' && hash == std::string_view::npos) hash = k;
+  }
+  if (hash != 3 && hash != 8) return false;
+  const std::string_view hex = text.substr(hash + 1);
+  if (hex.size() % 2 != 0 || hex.size() > 16) return false;
+  std::uint32_t id = 0;
+  if (!parse_hex_u32(text.substr(0, hash), id)) return false;
+  const bool extended = hash == 8;
+  if (extended ? (id > 0x1FFFFFFFu || (id & 0x20000000u)) : id > 0x7FFu) return false;  // error frames: the full reader
+  std::uint8_t data[8];
+  for (std::size_t k = 0; k < hex.size(); k += 2) {
+    const int hi = hex_value(hex[k]), lo = hex_value(hex[k + 1]);
+    if (hi < 0 || lo < 0) return false;
+    data[k / 2] = static_cast<std::uint8_t>(hi * 16 + lo);
+  }
+  double t = 0;
+  std::string error;
+  if (!parse_seconds(ts, t, error)) return false;
+  out.frame = Frame{};
+  out.frame.id = id;
+  out.frame.extended = extended;
+  out.frame.len = static_cast<std::uint8_t>(hex.size() / 2);
+  std::memcpy(out.frame.data.data(), data, out.frame.len);
+  out.frame.timestamp_s = t;
+  out.interface.assign(iface);
+  return true;
+}
+
+}  // namespace
+
 namespace detail {
 
 bool candump_line(std::string_view line, long lineno, const std::string& file, LogReadReport* report, LogEntry& out) {
   if (line.find_first_not_of(" \t\r") == std::string_view::npos) return false;
+  if (fast_log_line(line, out)) return true;  // classic frames, valid by construction
   std::string error;
   auto e = parse_log_line(line, error);
   if (e && !e->frame.valid()) {
