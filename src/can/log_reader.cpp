@@ -105,12 +105,20 @@ class LineSource {
         const std::size_t at = static_cast<std::size_t>(static_cast<const char*>(nl) - buf_.data());
         line = std::string_view(buf_.data() + begin_, at - begin_);
         begin_ = at + 1;
+        if (line.size() > LogReader::kMaxLineBytes) {  // whole in the buffer, still too long
+          line = {};
+          overlong = true;
+        }
         return true;
       }
       if (eof_) {
         if (begin_ == end_) return false;
         line = std::string_view(buf_.data() + begin_, end_ - begin_);
         begin_ = end_;
+        if (line.size() > LogReader::kMaxLineBytes) {
+          line = {};
+          overlong = true;
+        }
         return true;
       }
       if (end_ - begin_ > LogReader::kMaxLineBytes) {
