@@ -1,4 +1,5 @@
 // lash can replay | convert: parse, call lash::can, print.
+#include <filesystem>
 #include <memory>
 
 #include <fmt/core.h>
@@ -13,6 +14,14 @@
 namespace lash::cli::can_cmd {
 namespace {
 
+/// replay and convert read their input twice: a pipe (or `-`) would be empty the second time.
+void require_rereadable(const std::string& path, const char* who) {
+  std::error_code ec;
+  if (path == "-" || (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec)))
+    throw InputError(path, 0, "", fmt::format("lash can {} reads the log twice (a check, then the work): give a regular "
+                                              "file, not a pipe", who));
+}
+
 struct ReplayArgs {
   std::string bus;
   std::string log;
@@ -24,6 +33,7 @@ struct ReplayArgs {
 int run_replay(const ReplayArgs& a) {
   // a first pass checks the log (drops reported, exit 2 when nothing is valid) and counts its
   // frames before the bus is opened; the second sends them as they are read
+  require_rereadable(a.log, "replay");
   std::uint64_t total = 0;
   {
     ReportingReader check(a.log, "replay");
@@ -58,6 +68,7 @@ struct ConvertArgs {
 int run_convert(const ConvertArgs& a) {
   // two passes, each one frame at a time: the first checks the log and finds its earliest time
   // (the relative formats write offsets from it), the second writes
+  require_rereadable(a.in, "convert");
   can::LogTimes times;
   {
     ReportingReader check(a.in, "convert");

@@ -118,3 +118,10 @@ assert early.startswith(lines[0][1:lines[0].index(")")] + " BenchSensors PilotPr
 duty = float(early.split("PilotPressure_Duty=")[1].split()[0])
 assert abs(duty - int.from_bytes(first[0:2], "little") * 0.00152590218966964) < 1e-9, (early, first.hex())
 print(f"FIFO: the first line came out while the writer held the FIFO open; {len(out)} lines in all: {early.strip()[:80]}")
+
+# replay and convert read the log twice: a pipe is refused at once (exit 2, naming it), not half-sent
+for cmd in ([LASH, "can", "replay", "--bus", "mem:stream_test", "-"], [LASH, "can", "convert", fifo, os.path.join(tmp, "x.asc")]):
+    r = subprocess.run(cmd, input="(1.000000) can0 123#00\n", capture_output=True, text=True, timeout=30)
+    assert r.returncode == 2 and "give a regular file" in r.stderr, (cmd, r.returncode, r.stderr)
+    assert not os.path.exists(os.path.join(tmp, "x.asc"))
+print("replay of standard input and convert of a FIFO: exit 2 (they read the log twice)")
