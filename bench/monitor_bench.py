@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """`lash monitor` in file mode: its speed against `lash can decode` of the same log, and its peak
-memory on a log and on one 10 times longer (docs/monitor.md, "Cost").
+memory on a log and on longer ones (docs/monitor.md, "Cost"; e.g. 1 h and 24 h of the bench's bus).
 
 The logs are the emulated bench's frames: a `lash hil run` master_bus.log (40 s, 200 Hz, two
 frames per sample) repeated end to end, each copy shifted by the log's span (its alive counters
@@ -10,10 +10,13 @@ the other loads of a shared machine do not enter; peak memory is the child's ru_
 
 Printed per log: frames, `lash can decode --dbc DBC LOG > /dev/null` frames/s,
 `lash monitor LOG ...` frames/s at --every 1 and --every 60 (the default 120 s window), their
-ratios to decode, and the peak RSS of each; then the RSS ratio 10x / 1x of the monitor.
+ratios to decode (decode CPU time / monitor CPU time: above 1, the monitor reads the log faster
+than decode prints it), and the peak RSS of each; then the RSS ratio of the longest log to the
+shortest for each command (both stream the log: about 1).
 
 usage: bench/monitor_bench.py [--lash build/bin/lash] [--log master_bus.log] [--minutes 10]
-                              [--every 1,60] [--no-decode]
+                              [--scales 1,10] [--every 1,60] [--no-decode]
+       e.g. --minutes 60 --scales 1,24 --every 60: 1 h and 24 h of the bench's bus
        (without --log it runs `lash hil run` of the valve drift scenario first, 40 s)
 """
 import argparse
@@ -27,10 +30,10 @@ SRC = os.path.join(HERE, "..")
 ap = argparse.ArgumentParser()
 ap.add_argument("--lash", default=os.path.join(SRC, "build", "bin", "lash"))
 ap.add_argument("--log", help="a master_bus.log of the bench (default: a fresh lash hil run)")
-ap.add_argument("--minutes", type=float, default=10.0, help="length of the 1x log [min] (the other is 10x)")
+ap.add_argument("--minutes", type=float, default=10.0, help="length of the 1x log [min]")
+ap.add_argument("--scales", default="1,10", help="lengths of the logs in units of --minutes, comma-separated")
 ap.add_argument("--every", default="1,60", help="--every values of the monitor runs [s], comma-separated")
-ap.add_argument("--no-decode", action="store_true",
-                help="skip lash can decode (it reads the whole log: about 6x the file in memory)")
+ap.add_argument("--no-decode", action="store_true", help="skip lash can decode")
 a = ap.parse_args()
 
 DBC = os.path.join(SRC, "config", "monitor", "hydraulic_bench_kpa.dbc")
@@ -61,27 +64,39 @@ def long_log(copies):
     return path, copies * len(lines), copies * span
 
 
+# A child's ru_maxrss starts from its parent's high-water mark at fork (kept across exec): each
+# command is started by a small Python process, not by this one.
+SPAWN = """import os, sys
+with open(os.devnull, "w") as null:
+    pid = os.fork()
+    if pid == 0:
+        os.dup2(null.fileno(), 1)
+        os.execv(sys.argv[1], sys.argv[1:])
+    _, status, ru = os.wait4(pid, 0)
+print(os.waitstatus_to_exitcode(status), ru.ru_utime + ru.ru_stime, ru.ru_maxrss)
+"""
+
+
 def run(cmd):
-    """CPU seconds and peak RSS [MiB] of the child, from wait4."""
-    with open(os.devnull, "w") as null:
-        p = subprocess.Popen(cmd, stdout=null, stderr=subprocess.PIPE)
-        _, status, ru = os.wait4(p.pid, 0)
-        err = p.stderr.read().decode()
-        p.stderr.close()
-    if os.waitstatus_to_exitcode(status) != 0:
-        sys.exit(f"{' '.join(cmd)} failed: {err}")
-    return ru.ru_utime + ru.ru_stime, ru.ru_maxrss / 1024.0
+    """CPU seconds (user + system) and peak RSS [MiB] of the command, from wait4."""
+    r = subprocess.run([sys.executable, "-c", SPAWN, *cmd], capture_output=True, text=True)
+    status, cpu, kib = r.stdout.split()
+    if status != "0":
+        sys.exit(f"{' '.join(cmd)} failed: {r.stderr}")
+    return float(cpu), int(kib) / 1024.0
 
 
 rss = {}
 everys = a.every.split(",")
+scales = [int(x) for x in a.scales.split(",")]
 copies = max(1, round(a.minutes * 60 / span))
-for scale in (1, 10):
+for scale in scales:
     path, frames, seconds = long_log(copies * scale)
     print(f"{scale:2d}x log: {frames} frames, {seconds / 60:.1f} min of bus, {os.path.getsize(path) / 2**20:.0f} MiB")
     t_dec = float("nan")
     if not a.no_decode:
         t_dec, m_dec = run([a.lash, "can", "decode", "--dbc", DBC, path])
+        rss[(scale, "decode")] = m_dec
         print(f"    lash can decode          {frames / t_dec:12.0f} frames/s  ({t_dec:7.2f} s CPU)  "
               f"peak RSS {m_dec:7.1f} MiB")
     for every in everys:
@@ -90,5 +105,7 @@ for scale in (1, 10):
         print(f"    lash monitor --every {every:2s}  {frames / t_mon:12.0f} frames/s  ({t_mon:7.2f} s CPU)  "
               f"peak RSS {m_mon:7.1f} MiB" + ("" if a.no_decode else f"  ratio to decode {t_dec / t_mon:.3f}"))
     os.remove(path)
-for every in everys:
-    print(f"monitor --every {every}: peak RSS 10x / 1x = {rss[(10, every)] / rss[(1, every)]:.3f}")
+lo, hi = scales[0], scales[-1]
+for every in ([] if a.no_decode else ["decode"]) + everys:
+    what = "lash can decode" if every == "decode" else f"monitor --every {every}"
+    print(f"{what}: peak RSS {hi}x / {lo}x = {rss[(hi, every)] / rss[(lo, every)]:.3f}")

@@ -2,5 +2,6 @@
 #include "fuzz_can_log_format.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  return lash::can::fuzz::round_trip(&lash::can::detail::parse_trc, &lash::can::detail::write_trc, data, size);
+  return lash::can::fuzz::round_trip(&lash::can::detail::parse_trc, &lash::can::detail::write_trc, lash::can::LogFormat::trc, data,
+                                         size);
 }

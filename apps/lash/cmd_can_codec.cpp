@@ -57,12 +57,12 @@ struct DecodeOptions {
 
 int run_decode(const DecodeOptions& o) {
   const auto db = load(o.dbc, o.strict, false);
-  const auto entries = read_log_reporting(o.log, "decode");
+  ReportingReader reader(o.log, "decode");  // one frame at a time: a line is printed as its frame is read
   std::map<std::pair<std::uint32_t, bool>, std::unique_ptr<can::MessageCodec>> codecs;
   std::map<std::pair<std::uint32_t, bool>, std::string> broken;  // messages whose layout has errors
   std::vector<double> values;
   std::string out;
-  for (const auto& e : entries) {
+  for (can::LogEntry e; reader.next(e);) {
     const auto& f = e.frame;
     out = fmt::format("{:.6f}", f.timestamp_s);
     const auto* m = db.message(f.id, f.extended);
@@ -101,6 +101,7 @@ int run_decode(const DecodeOptions& o) {
     }
     std::puts(out.c_str());
   }
+  reader.finish();
   return kExitOk;
 }
 

@@ -1,4 +1,5 @@
 // lash can replay | convert: parse, call lash::can, print.
+#include <filesystem>
 #include <memory>
 
 #include <fmt/core.h>
@@ -7,10 +8,19 @@
 #include "lash/can/bus.hpp"
 #include "lash/can/log.hpp"
 #include "lash/can/replay.hpp"
+#include "lash/io/atomic_file.hpp"
 #include "lash/io/error.hpp"
 
 namespace lash::cli::can_cmd {
 namespace {
+
+/// replay and convert read their input twice: a pipe (or `-`) would be empty the second time.
+void require_rereadable(const std::string& path, const char* who) {
+  std::error_code ec;
+  if (path == "-" || (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec)))
+    throw InputError(path, 0, "", fmt::format("lash can {} reads the log twice (a check, then the work): give a regular "
+                                              "file, not a pipe", who));
+}
 
 struct ReplayArgs {
   std::string bus;
@@ -21,18 +31,30 @@ struct ReplayArgs {
 };
 
 int run_replay(const ReplayArgs& a) {
-  const auto entries = read_log_reporting(a.log, "replay");
+  // a first pass checks the log (drops reported, exit 2 when nothing is valid) and counts its
+  // frames before the bus is opened; the second sends them as they are read
+  require_rereadable(a.log, "replay");
+  std::uint64_t total = 0;
+  {
+    ReportingReader check(a.log, "replay");
+    for (can::LogEntry e; check.next(e);) {
+    }
+    total = check.finish();
+  }
+  can::LogReadReport again;
+  can::LogReader reader(a.log, &again);
+  reader.keep_problems(0);
   auto bus = can::open_bus(a.bus);
   can::ReplayOptions o;
   o.speed = a.speed;
   o.spin_ns = static_cast<std::int64_t>(a.spin_us * 1e3);
   o.fifo_priority = a.rt_priority;
   install_stop_handler();
-  const auto r = can::replay(*bus, entries, o, g_stop);
+  const auto r = can::replay(*bus, [&](can::LogEntry& e) { return reader.next(e); }, o, g_stop);
   if (!r.warning.empty()) fmt::print(stderr, "lash can replay: {}; continuing without\n", r.warning);
-  if (r.interrupted) fmt::print(stderr, "lash can replay: stopped by a signal after {} of {} frames\n", r.sent + r.failed, entries.size());
+  if (r.interrupted) fmt::print(stderr, "lash can replay: stopped by a signal after {} of {} frames\n", r.sent + r.failed, total);
   if (r.failed) {
-    fmt::print(stderr, "lash can replay: {} of {} frames failed to send\n", r.failed, entries.size());
+    fmt::print(stderr, "lash can replay: {} of {} frames failed to send\n", r.failed, total);
     return kExitFailed;
   }
   return kExitOk;
@@ -44,30 +66,53 @@ struct ConvertArgs {
 };
 
 int run_convert(const ConvertArgs& a) {
-  const auto entries = read_log_reporting(a.in, "convert");
-  can::write_log(a.out, entries);
-  fmt::print(stderr, "lash can convert: {} frames, {} -> {}\n", entries.size(), can::to_string(can::log_format_of(a.in)),
+  // two passes, each one frame at a time: the first checks the log and finds its earliest time
+  // (the relative formats write offsets from it), the second writes
+  require_rereadable(a.in, "convert");
+  can::LogTimes times;
+  {
+    ReportingReader check(a.in, "convert");
+    for (can::LogEntry e; check.next(e);) times.add(e.frame.timestamp_s);
+    check.finish();
+  }
+  can::LogReadReport again;
+  can::LogReader reader(a.in, &again);
+  reader.keep_problems(0);
+  AtomicFile out(a.out);
+  can::LogWriter writer(out.stream(), can::log_format_of(a.out), times, a.out);
+  for (can::LogEntry e; reader.next(e);) writer.write(e);
+  writer.finish();
+  out.commit();
+  fmt::print(stderr, "lash can convert: {} frames, {} -> {}\n", times.count, can::to_string(can::log_format_of(a.in)),
              can::to_string(can::log_format_of(a.out)));
   return kExitOk;
 }
 
 }  // namespace
 
-std::vector<can::LogEntry> read_log_reporting(const std::string& path, const char* who) {
-  can::LogReadReport report;
-  auto entries = can::read_log(path, &report);
-  constexpr std::size_t kShown = 20;  // a binary file is thousands of bad "lines": the count says the rest
+namespace {
+constexpr std::size_t kShown = 20;  // a binary file is thousands of bad "lines": the count says the rest
+}  // namespace
+
+ReportingReader::ReportingReader(const std::string& path, const char* who)
+    : path_(path), who_(who), reader_(path, &report_) {
+  reader_.keep_problems(kShown);
+}
+
+std::uint64_t ReportingReader::finish() {
+  const auto& report = report_;
   for (std::size_t i = 0; i < report.problems.size() && i < kShown; ++i) {
     const std::string& p = report.problems[i];
-    fmt::print(stderr, "lash can {}: dropped: {}\n", who, p.size() <= 200 ? p : p.substr(0, 200) + "\u2026");
+    fmt::print(stderr, "lash can {}: dropped: {}\n", who_, p.size() <= 200 ? p : p.substr(0, 200) + "\u2026");
   }
-  if (report.problems.size() > kShown)
-    fmt::print(stderr, "lash can {}: ... and {} more dropped records\n", who, report.problems.size() - kShown);
+  if (report.dropped > kShown)
+    fmt::print(stderr, "lash can {}: ... and {} more dropped records\n", who_, report.dropped - kShown);
+  const std::uint64_t n = reader_.count();
   if (report.dropped)
-    fmt::print(stderr, "lash can {}: {} of {} records of {} dropped\n", who, report.dropped, report.dropped + entries.size(), path);
-  if (entries.empty() && report.dropped)
-    throw InputError(path, 0, "", "no valid frame: all " + std::to_string(report.dropped) + " records were dropped (not a CAN log?)");
-  return entries;
+    fmt::print(stderr, "lash can {}: {} of {} records of {} dropped\n", who_, report.dropped, report.dropped + n, path_);
+  if (n == 0 && report.dropped)
+    throw InputError(path_, 0, "", "no valid frame: all " + std::to_string(report.dropped) + " records were dropped (not a CAN log?)");
+  return n;
 }
 
 std::vector<Sub> add_replay_command(CLI::App& sub) {

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -10,6 +11,7 @@
 
 #include "lash/io/atomic_file.hpp"
 #include "lash/io/error.hpp"
+#include "lash/can/log_reader.hpp"
 #include "log_formats.hpp"
 
 namespace lash::can {
@@ -381,33 +383,87 @@ std::string format_log_line(const Frame& frame, std::string_view interface) {
                      format_frame_text(frame));
 }
 
-std::vector<LogEntry> parse_log(std::string_view text, const std::string& file, LogReadReport* report) {
-  std::vector<LogEntry> out;
-  int lineno = 0;
-  std::size_t pos = 0;
-  while (pos <= text.size()) {
-    auto nl = text.find('\n', pos);
-    if (nl == std::string_view::npos) nl = text.size();
-    const std::string_view line = text.substr(pos, nl - pos);
-    ++lineno;
-    pos = nl + 1;
-    if (line.find_first_not_of(" \t\r") == std::string_view::npos) {
-      if (nl == text.size()) break;
-      continue;
-    }
-    std::string error;
-    auto e = parse_log_line(line, error);
-    if (e && !e->frame.valid()) {
-      error = "invalid frame";
-      e.reset();
-    }
-    if (!e) {
-      detail::drop(report, file, lineno, "candump line", error);
-    } else {
-      out.push_back(std::move(*e));
-    }
-    if (nl == text.size()) break;
+namespace {
+
+/// The common candump -L line `(seconds.fraction) iface ID#HEX` of a classic data frame, parsed
+/// straight into `out` (its interface string reused): true when the line is of that form, false
+/// (nothing decided) otherwise; parse_log_line then reads it, with its messages. For the lines it
+/// takes, the result is parse_log_line's.
+bool fast_log_line(std::string_view s, LogEntry& out) {
+  while (!s.empty() && (s.back() == '\r' || s.back() == '\n' || s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
+  if (s.size() < 3 || s[0] != '(') return false;
+  const auto blank = [](char c) { return c == ' ' || c == '\t'; };  // (find_first_of calls memchr per character)
+  std::size_t close = 1;
+  while (close < s.size() && s[close] != ')') {
+    if (blank(s[close])) return false;
+    ++close;
   }
+  if (close < 2 || close + 2 >= s.size() || s[close + 1] != ' ') return false;
+  const std::string_view ts = s.substr(1, close - 1);
+  std::size_t i = close + 2;
+  std::size_t j = i;
+  while (j < s.size() && !blank(s[j])) ++j;
+  if (j == i || j >= s.size() || s[j] != ' ') return false;
+  const std::string_view iface = s.substr(i, j - i);
+  const std::string_view text = s.substr(j + 1);
+  std::size_t hash = std::string_view::npos;
+  for (std::size_t k = 0; k < text.size(); ++k) {
+    if (blank(text[k])) return false;
+    if (text[k] == '#' && hash == std::string_view::npos) hash = k;
+  }
+  if (hash != 3 && hash != 8) return false;
+  const std::string_view hex = text.substr(hash + 1);
+  if (hex.size() % 2 != 0 || hex.size() > 16) return false;
+  std::uint32_t id = 0;
+  if (!parse_hex_u32(text.substr(0, hash), id)) return false;
+  const bool extended = hash == 8;
+  if (extended ? (id > 0x1FFFFFFFu || (id & 0x20000000u)) : id > 0x7FFu) return false;  // error frames: the full reader
+  std::uint8_t data[8];
+  for (std::size_t k = 0; k < hex.size(); k += 2) {
+    const int hi = hex_value(hex[k]), lo = hex_value(hex[k + 1]);
+    if (hi < 0 || lo < 0) return false;
+    data[k / 2] = static_cast<std::uint8_t>(hi * 16 + lo);
+  }
+  double t = 0;
+  std::string error;
+  if (!parse_seconds(ts, t, error)) return false;
+  out.frame = Frame{};
+  out.frame.id = id;
+  out.frame.extended = extended;
+  out.frame.len = static_cast<std::uint8_t>(hex.size() / 2);
+  std::memcpy(out.frame.data.data(), data, out.frame.len);
+  out.frame.timestamp_s = t;
+  out.interface.assign(iface);
+  return true;
+}
+
+}  // namespace
+
+namespace detail {
+
+bool candump_line(std::string_view line, long lineno, const std::string& file, LogReadReport* report, LogEntry& out) {
+  if (line.find_first_not_of(" \t\r") == std::string_view::npos) return false;
+  if (fast_log_line(line, out)) return true;  // classic frames, valid by construction
+  std::string error;
+  auto e = parse_log_line(line, error);
+  if (e && !e->frame.valid()) {
+    error = "invalid frame";
+    e.reset();
+  }
+  if (!e) {
+    drop(report, file, lineno, "candump line", error);
+    return false;
+  }
+  out = std::move(*e);
+  return true;
+}
+
+}  // namespace detail
+
+std::vector<LogEntry> parse_log(std::string_view text, const std::string& file, LogReadReport* report) {
+  LogReader r(text, LogFormat::candump, file, report);
+  std::vector<LogEntry> out;
+  for (LogEntry e; r.next(e);) out.push_back(e);
   return out;
 }
 
@@ -429,22 +485,11 @@ const char* to_string(LogFormat f) noexcept {
   }
 }
 
-std::string read_file_bytes(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string(), 0, "", "cannot open log file for reading");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 std::vector<LogEntry> read_log(const std::filesystem::path& path, LogReadReport* report) {
-  const std::string bytes = read_file_bytes(path);
-  switch (log_format_of(path)) {
-    case LogFormat::asc: return detail::parse_asc(bytes, path.string(), report);
-    case LogFormat::blf: return detail::parse_blf(bytes, path.string(), report);
-    case LogFormat::trc: return detail::parse_trc(bytes, path.string(), report);
-    default: return parse_log(bytes, path.string(), report);
-  }
+  LogReader r(path, report);
+  std::vector<LogEntry> out;
+  for (LogEntry e; r.next(e);) out.push_back(e);
+  return out;
 }
 
 TimeSpan writable_times(LogFormat format) noexcept {
@@ -462,39 +507,47 @@ TimeSpan writable_times(LogFormat format) noexcept {
   }
 }
 
+namespace detail {
+
+TimeCheck::TimeCheck(LogFormat format, const LogTimes& times, std::string file)
+    : format_(format), span_(writable_times(format)), t0_(times.earliest_s), origin_(0.0), file_(std::move(file)) {
+  // BLF writes offsets from its header's start, the others from the earliest frame.
+  const bool t0_ok = std::isfinite(t0_) && t0_ >= span_.min_abs_s && t0_ < span_.max_abs_s;
+  origin_ = format == LogFormat::blf ? (t0_ok ? blf_start_of(t0_) : 0.0) : t0_;
+}
+
+void TimeCheck::check(double t, std::uint64_t index) const {
+  const double offset = t - origin_;
+  const char* why = nullptr;
+  if (!std::isfinite(t)) why = "is not a finite number";
+  else if (t < span_.min_abs_s || t >= span_.max_abs_s) why = "is outside the times the format can hold";
+  else if (!(offset < span_.max_offset_s) || !std::isfinite(offset)) why = "lies too far from the log's earliest frame";
+  if (why)
+    throw InputError(file_, 0, fmt::format("frame {}", index + 1),
+                     fmt::format("timestamp {} s {} for {} (times from {} s to {} s, at most {} s after the earliest frame at {} s); "
+                                 "nothing written",
+                                 t, why, to_string(format_), span_.min_abs_s, span_.max_abs_s, span_.max_offset_s, t0_));
+}
+
+}  // namespace detail
+
 void check_writable_times(const std::vector<LogEntry>& entries, LogFormat format, const std::string& file) {
   if (entries.empty()) return;
-  const TimeSpan span = writable_times(format);
-  double t0 = entries.front().frame.timestamp_s;
-  for (const auto& e : entries) t0 = std::min(t0, e.frame.timestamp_s);
-  // BLF writes offsets from its header's start, the others from the earliest frame.
-  const bool t0_ok = std::isfinite(t0) && t0 >= span.min_abs_s && t0 < span.max_abs_s;
-  const double origin = format == LogFormat::blf ? (t0_ok ? detail::blf_start_of(t0) : 0.0) : t0;
-  for (std::size_t i = 0; i < entries.size(); ++i) {
-    const double t = entries[i].frame.timestamp_s;
-    const double offset = t - origin;
-    const char* why = nullptr;
-    if (!std::isfinite(t)) why = "is not a finite number";
-    else if (t < span.min_abs_s || t >= span.max_abs_s) why = "is outside the times the format can hold";
-    else if (!(offset < span.max_offset_s) || !std::isfinite(offset)) why = "lies too far from the log's earliest frame";
-    if (why)
-      throw InputError(file, 0, fmt::format("frame {}", i + 1),
-                       fmt::format("timestamp {} s {} for {} (times from {} s to {} s, at most {} s after the earliest frame at {} s); "
-                                   "nothing written",
-                                   t, why, to_string(format), span.min_abs_s, span.max_abs_s, span.max_offset_s, t0));
-  }
+  LogTimes times;
+  for (const auto& e : entries) times.add(e.frame.timestamp_s);
+  const detail::TimeCheck check(format, times, file);
+  for (std::size_t i = 0; i < entries.size(); ++i) check.check(entries[i].frame.timestamp_s, i);
 }
 
 void write_log(const std::filesystem::path& path, const std::vector<LogEntry>& entries) {
-  check_writable_times(entries, log_format_of(path), path.string());
+  const LogFormat format = log_format_of(path);
+  check_writable_times(entries, format, path.string());
+  LogTimes times;
+  for (const auto& e : entries) times.add(e.frame.timestamp_s);
   AtomicFile f(path);
-  switch (log_format_of(path)) {
-    case LogFormat::asc: detail::write_asc(f.stream(), entries); break;
-    case LogFormat::blf: detail::write_blf(f.stream(), entries); break;
-    case LogFormat::trc: detail::write_trc(f.stream(), entries); break;
-    default:
-      for (const auto& e : entries) f.stream() << format_log_line(e.frame, e.interface) << '\n';
-  }
+  LogWriter w(f.stream(), format, times, path.string());
+  for (const auto& e : entries) w.write(e);
+  w.finish();
   f.commit();
 }
 

@@ -122,78 +122,82 @@ std::string parse_frame_line(const std::string_view* p, std::size_t n, int base,
 
 }  // namespace
 
-std::vector<LogEntry> parse_asc(std::string_view text, const std::string& file, LogReadReport* report) {
-  std::vector<LogEntry> out;
-  int base = 16;
-  long lineno = 0;
-  std::size_t pos = 0;
+bool AscLines::line(std::string_view line, long lineno, const std::string& file, LogReadReport* report, LogEntry& out) {
   constexpr std::size_t kMax = 96;
   std::string_view p[kMax];
-  while (pos < text.size()) {
-    auto nl = text.find('\n', pos);
-    if (nl == std::string_view::npos) nl = text.size();
-    const std::string_view line = text.substr(pos, nl - pos);
-    pos = nl + 1;
-    ++lineno;
-    const std::size_t n = split_blank(line, p, kMax);
-    if (n == 0) continue;
-    if (iequals(p[0], "base") && n >= 2) {
-      if (iequals(p[1], "dec")) base = 10;
-      else if (iequals(p[1], "hex")) base = 16;
-      else drop(report, file, lineno, "base", "expected hex or dec");
-      continue;
-    }
-    double t = 0;
-    if (n < 3 || !to_seconds(p[0], t)) continue;  // header, comment, trigger block, event text
-    // python-can's frame pattern: t ch (id dir | ErrorFrame) | t CANFD …
-    const bool digit_channel = !p[1].empty() && p[1].find_first_not_of("0123456789") == std::string_view::npos;
-    const bool is_frame = iequals(p[1], "CANFD") ||
-                          (digit_channel && ((p[2].size() >= 10 && iequals(p[2].substr(0, 10), "errorframe")) ||
-                                             (n >= 4 && (p[3] == "Rx" || p[3] == "Tx" || iequals(p[3], "rx") || iequals(p[3], "tx")))));
-    if (!is_frame) continue;  // statistics, events, other buses
-    LogEntry e;
-    e.frame.timestamp_s = t;
-    const std::string why = parse_frame_line(p, n, base, e);
-    if (!why.empty()) {
-      drop(report, file, lineno, "frame", why);
-      continue;
-    }
-    out.push_back(std::move(e));
+  const std::size_t n = split_blank(line, p, kMax);
+  if (n == 0) return false;
+  if (iequals(p[0], "base") && n >= 2) {
+    if (iequals(p[1], "dec")) base_ = 10;
+    else if (iequals(p[1], "hex")) base_ = 16;
+    else drop(report, file, lineno, "base", "expected hex or dec");
+    return false;
   }
+  double t = 0;
+  if (n < 3 || !to_seconds(p[0], t)) return false;  // header, comment, trigger block, event text
+  // python-can's frame pattern: t ch (id dir | ErrorFrame) | t CANFD …
+  const bool digit_channel = !p[1].empty() && p[1].find_first_not_of("0123456789") == std::string_view::npos;
+  const bool is_frame = iequals(p[1], "CANFD") ||
+                        (digit_channel && ((p[2].size() >= 10 && iequals(p[2].substr(0, 10), "errorframe")) ||
+                                           (n >= 4 && (p[3] == "Rx" || p[3] == "Tx" || iequals(p[3], "rx") || iequals(p[3], "tx")))));
+  if (!is_frame) return false;  // statistics, events, other buses
+  LogEntry e;
+  e.frame.timestamp_s = t;
+  const std::string why = parse_frame_line(p, n, base_, e);
+  if (!why.empty()) {
+    drop(report, file, lineno, "frame", why);
+    return false;
+  }
+  out = std::move(e);
+  return true;
+}
+
+std::vector<LogEntry> parse_asc(std::string_view text, const std::string& file, LogReadReport* report) {
+  LogReader r(text, LogFormat::asc, file, report);
+  std::vector<LogEntry> out;
+  for (LogEntry e; r.next(e);) out.push_back(e);
   return out;
 }
 
-void write_asc(std::ostream& os, const std::vector<LogEntry>& entries) {
-  check_writable_times(entries, LogFormat::asc, "");
+void asc_header(std::ostream& os) {
   os << "date Thu Jan 01 00:00:00.000 am 1970\nbase hex  timestamps absolute\ninternal events logged\n";
   os << "// version 9.0.0\nBegin Triggerblock Thu Jan 01 00:00:00.000 am 1970\n";
   os << fmt::format("{: 9.6f} Start of measurement\n", 0.0);
+}
+
+void asc_entry(std::ostream& os, const LogEntry& e, double t0) {
   // Times from the earliest frame (logs may go backwards), so that none is negative.
-  double t0 = entries.empty() ? 0.0 : entries.front().frame.timestamp_s;
-  for (const auto& e : entries) t0 = std::min(t0, e.frame.timestamp_s);
-  for (const auto& e : entries) {
-    const Frame& f = e.frame;
-    const double t = f.timestamp_s - t0;
-    std::uint32_t ch = 1;
-    if (!to_uint(e.interface, 10, ch) || ch == 0) ch = 1;
-    if (f.error) {
-      os << fmt::format("{: 9.6f} {}  ErrorFrame\n", t, ch);
-      continue;
-    }
-    std::string id = fmt::format("{:X}{}", f.id, f.extended ? "x" : "");
-    std::string data;
-    for (std::size_t i = 0; i < f.len && !f.remote; ++i) data += fmt::format("{}{:02X}", i ? " " : "", f.data[i]);
-    if (f.fd) {
-      const unsigned flags = (1u << 12) | (f.brs ? 1u << 13 : 0u) | (f.esi ? 1u << 14 : 0u);
-      os << fmt::format("{: 9.6f} CANFD {:>3} {:<4} {:>8}  {:>32} {} {} {:x} {:>2} {} {:>8} {:>4} {:>8X} {:>8} {:>8} {:>8} {:>8} {:>8}\n",
-                        t, ch, "Rx", id, "", f.brs ? 1 : 0, f.esi ? 1 : 0, fd_dlc(f.len), f.len, data, 0, 0, flags, 0, 0, 0, 0, 0);
-    } else if (f.remote) {
-      os << fmt::format("{: 9.6f} {}  {:<15} {:<4} r {:x} \n", t, ch, id, "Rx", f.len);
-    } else {
-      os << fmt::format("{: 9.6f} {}  {:<15} {:<4} d {:x} {}\n", t, ch, id, "Rx", f.len, data);
-    }
+  const Frame& f = e.frame;
+  const double t = f.timestamp_s - t0;
+  std::uint32_t ch = 1;
+  if (!to_uint(e.interface, 10, ch) || ch == 0) ch = 1;
+  if (f.error) {
+    os << fmt::format("{: 9.6f} {}  ErrorFrame\n", t, ch);
+    return;
   }
-  os << "End TriggerBlock\n";
+  std::string id = fmt::format("{:X}{}", f.id, f.extended ? "x" : "");
+  std::string data;
+  for (std::size_t i = 0; i < f.len && !f.remote; ++i) data += fmt::format("{}{:02X}", i ? " " : "", f.data[i]);
+  if (f.fd) {
+    const unsigned flags = (1u << 12) | (f.brs ? 1u << 13 : 0u) | (f.esi ? 1u << 14 : 0u);
+    os << fmt::format("{: 9.6f} CANFD {:>3} {:<4} {:>8}  {:>32} {} {} {:x} {:>2} {} {:>8} {:>4} {:>8X} {:>8} {:>8} {:>8} {:>8} {:>8}\n",
+                      t, ch, "Rx", id, "", f.brs ? 1 : 0, f.esi ? 1 : 0, fd_dlc(f.len), f.len, data, 0, 0, flags, 0, 0, 0, 0, 0);
+  } else if (f.remote) {
+    os << fmt::format("{: 9.6f} {}  {:<15} {:<4} r {:x} \n", t, ch, id, "Rx", f.len);
+  } else {
+    os << fmt::format("{: 9.6f} {}  {:<15} {:<4} d {:x} {}\n", t, ch, id, "Rx", f.len, data);
+  }
+}
+
+void asc_trailer(std::ostream& os) { os << "End TriggerBlock\n"; }
+
+void write_asc(std::ostream& os, const std::vector<LogEntry>& entries) {
+  check_writable_times(entries, LogFormat::asc, "");
+  LogTimes times;
+  for (const auto& e : entries) times.add(e.frame.timestamp_s);
+  LogWriter w(os, LogFormat::asc, times);
+  for (const auto& e : entries) w.write(e);
+  w.finish();
 }
 
 }  // namespace lash::can::detail

@@ -3,12 +3,12 @@
 #include <time.h>
 
 #include <filesystem>
-#include <fstream>
 #include <thread>
 #include <vector>
 
 #include "lash/can/bus.hpp"
 #include "lash/can/log.hpp"
+#include "lash/can/log_reader.hpp"
 #include "lash/io/error.hpp"
 
 namespace lash::monitor {
@@ -68,63 +68,26 @@ class Pacer {
   std::chrono::steady_clock::time_point wall0_;
 };
 
-/// candump -L, line by line.
-class CandumpSource final : public FrameSource {
+/// A log file (candump, ASC, BLF, TRC), one frame at a time (can::LogReader: bounded memory).
+class LogSource final : public FrameSource {
  public:
-  CandumpSource(const std::string& path, bool realtime, const std::atomic<bool>* stop)
-      : in_(path), pacer_(realtime, stop) {
-    if (!in_) throw InputError(path, 0, "SOURCE", "cannot open the log");
+  LogSource(const std::string& path, bool realtime, const std::atomic<bool>* stop)
+      : reader_(path, &report_), pacer_(realtime, stop) {
+    reader_.keep_problems(0);  // counted, not kept
   }
   Next next(can::Frame& out, std::chrono::nanoseconds) override {
-    while (std::getline(in_, line_)) {
-      std::string_view s(line_);
-      while (!s.empty() && (s.back() == '\r' || s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
-      std::size_t b = 0;
-      while (b < s.size() && (s[b] == ' ' || s[b] == '\t')) ++b;
-      s.remove_prefix(b);
-      if (s.empty() || s.front() == '#') continue;
-      auto e = can::parse_log_line(s, error_);
-      if (!e) {
-        ++garbage_;
-        continue;
-      }
-      out = e->frame;
-      pacer_.wait_for(out.timestamp_s);
-      return Next::frame;
-    }
-    return Next::end;
-  }
-  std::uint64_t garbage() const noexcept override { return garbage_; }
-  bool live() const noexcept override { return false; }
-
- private:
-  std::ifstream in_;
-  std::string line_, error_;
-  std::uint64_t garbage_ = 0;
-  Pacer pacer_;
-};
-
-/// ASC, BLF, TRC: read by the can module's readers (whole file), delivered one by one.
-class WholeLogSource final : public FrameSource {
- public:
-  WholeLogSource(const std::string& path, bool realtime, const std::atomic<bool>* stop) : pacer_(realtime, stop) {
-    can::LogReadReport report;
-    entries_ = can::read_log(path, &report);
-    garbage_ = report.dropped;
-  }
-  Next next(can::Frame& out, std::chrono::nanoseconds) override {
-    if (i_ >= entries_.size()) return Next::end;
-    out = entries_[i_++].frame;
+    if (!reader_.next(entry_)) return Next::end;
+    out = entry_.frame;
     pacer_.wait_for(out.timestamp_s);
     return Next::frame;
   }
-  std::uint64_t garbage() const noexcept override { return garbage_; }
+  std::uint64_t garbage() const noexcept override { return report_.dropped; }
   bool live() const noexcept override { return false; }
 
  private:
-  std::vector<can::LogEntry> entries_;
-  std::size_t i_ = 0;
-  std::uint64_t garbage_ = 0;
+  can::LogReadReport report_;
+  can::LogReader reader_;
+  can::LogEntry entry_;
   Pacer pacer_;
 };
 
@@ -134,11 +97,9 @@ std::unique_ptr<FrameSource> open_source(const std::string& spec, bool realtime,
   for (const char* scheme : {"udp:", "socketcan:", "mem:"})
     if (spec.rfind(scheme, 0) == 0) return std::make_unique<BusSource>(spec);
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(spec, ec))
+  if (!std::filesystem::exists(spec, ec) || std::filesystem::is_directory(spec, ec))
     throw InputError(spec, 0, "SOURCE", "no such log file (and not a bus address udp:… / socketcan:… / mem:…)");
-  if (can::log_format_of(spec) == can::LogFormat::candump)
-    return std::make_unique<CandumpSource>(spec, realtime, stop);
-  return std::make_unique<WholeLogSource>(spec, realtime, stop);
+  return std::make_unique<LogSource>(spec, realtime, stop);
 }
 
 }  // namespace lash::monitor

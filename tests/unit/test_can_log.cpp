@@ -3,9 +3,12 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <limits>
 
 #include "lash/can/log.hpp"
+#include "lash/can/log_reader.hpp"
 #include "lash/io/error.hpp"
 
 using namespace lash::can;
@@ -187,4 +190,125 @@ TEST(CanLog, BlfKeepsTimesAtTheEdgeOfItsRange) {
   ASSERT_EQ(back.size(), 2u);
   EXPECT_DOUBLE_EQ(back[1].frame.timestamp_s, 18446744000.0);
   std::filesystem::remove(p);
+}
+
+namespace {
+/// Random frames of every kind (classic, extended, remote, error, FD with BRS/ESI), 1 ms apart.
+std::vector<LogEntry> random_entries(std::size_t n, std::uint32_t seed) {
+  std::uint64_t s = seed * 6364136223846793005ull + 1442695040888963407ull;
+  const auto next = [&] {
+    s = s * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<std::uint32_t>(s >> 33);
+  };
+  std::vector<LogEntry> v;
+  for (std::size_t i = 0; i < n; ++i) {
+    LogEntry e;
+    e.interface = "1";
+    Frame& f = e.frame;
+    f.timestamp_s = 1600000000.0 + 0.001 * static_cast<double>(i);
+    const std::uint32_t kind = next() % 10;
+    f.extended = kind == 1 || kind == 5;
+    f.id = next() & (f.extended ? 0x1FFFFFFFu : 0x7FFu);
+    if (kind == 2) {
+      f.remote = true;
+      f.len = static_cast<std::uint8_t>(next() % 9);
+    } else if (kind == 3) {
+      f.error = true;  // ASC and TRC error frames hold no class bits nor data
+      f.extended = false;
+      f.id = 0;
+      f.len = 0;
+    } else if (kind >= 4 && kind <= 5) {
+      static constexpr std::uint8_t fd[] = {0, 5, 8, 12, 16, 20, 24, 32, 48, 64};
+      f.fd = true;
+      f.brs = next() % 2;
+      f.esi = next() % 2;
+      f.len = fd[next() % 10];
+    } else {
+      f.len = static_cast<std::uint8_t>(next() % 9);
+    }
+    if (!f.remote)
+      for (std::size_t k = 0; k < f.len; ++k) f.data[k] = static_cast<std::uint8_t>(next());
+    v.push_back(e);
+  }
+  return v;
+}
+
+std::string file_bytes(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+struct Read {
+  std::vector<LogEntry> entries;
+  LogReadReport report;
+};
+Read read_chunked(std::string_view bytes, LogFormat format, std::size_t chunk) {
+  Read r;
+  LogReader reader(bytes, format, "x", &r.report, chunk);
+  for (LogEntry e; reader.next(e);) r.entries.push_back(e);
+  EXPECT_EQ(reader.count(), r.entries.size());
+  return r;
+}
+}  // namespace
+
+// LogReader hands out the frames and drops of the whole text whatever pieces the bytes arrive in
+// (a FIFO written slowly): every record boundary, BLF objects continued in the next container
+// (lash writes 128 KiB containers: 20 000 frames span several) and damage included.
+TEST(CanLog, StreamingReadIsTheWholeRead) {
+  const auto entries = random_entries(20000, 7);
+  for (const char* ext : {".log", ".asc", ".trc", ".blf"}) {
+    const auto p = std::filesystem::temp_directory_path() / (std::string("lash_test_stream") + ext);
+    write_log(p, entries);
+    std::string bytes = file_bytes(p);
+    std::filesystem::remove(p);
+    const LogFormat format = log_format_of(p);
+    const Read whole = read_chunked(bytes, format, 0);
+    ASSERT_EQ(whole.entries.size(), entries.size()) << ext;
+    EXPECT_EQ(whole.report.dropped, 0u) << ext;
+    for (std::size_t i = 0; i < entries.size(); ++i)
+      ASSERT_TRUE(same_content(whole.entries[i].frame, entries[i].frame)) << ext << " frame " << i;
+    // damage: garbage lines in the texts; a BLF cut in the middle of a container
+    std::size_t expect_dropped = 0;
+    if (format == LogFormat::blf) {
+      bytes.resize(bytes.size() * 2 / 3);
+      expect_dropped = 1;
+    } else {
+      for (std::size_t at = bytes.size() / 7, k = 0; k < 5; ++k, at += bytes.size() / 7) {
+        at = bytes.find('\n', at) + 1;
+        bytes.insert(at, format == LogFormat::candump ? "(1.0) x 12#0\n"
+                         : format == LogFormat::asc   ? "1.000000 1 7FF Rx d 9 00\n"
+                                                      : "      1       1.000 DT  1     07FF Rx -  9    00\r\n");
+        ++expect_dropped;
+      }
+    }
+    const Read damaged = read_chunked(bytes, format, 0);
+    EXPECT_EQ(damaged.report.dropped, expect_dropped) << ext;
+    for (const std::size_t chunk : {std::size_t{1}, std::size_t{3}, std::size_t{4093}}) {
+      const Read r = read_chunked(bytes, format, chunk);
+      ASSERT_EQ(r.entries.size(), damaged.entries.size()) << ext << " chunk " << chunk;
+      for (std::size_t i = 0; i < r.entries.size(); ++i) {
+        ASSERT_TRUE(same_content(r.entries[i].frame, damaged.entries[i].frame)) << ext << " chunk " << chunk << " frame " << i;
+        ASSERT_EQ(r.entries[i].frame.timestamp_s, damaged.entries[i].frame.timestamp_s);
+        ASSERT_EQ(r.entries[i].interface, damaged.entries[i].interface);
+      }
+      EXPECT_EQ(r.report.problems, damaged.report.problems) << ext << " chunk " << chunk;
+    }
+  }
+}
+
+TEST(CanLog, StreamingReadDropsOverlongLinesAndKeepsFewProblems) {
+  std::string text = "(1.000000) can0 123#00\n" + std::string(LogReader::kMaxLineBytes + 10, 'x') + "\n";
+  for (int i = 0; i < 50; ++i) text += "garbage\n";
+  text += "(2.000000) can0 124#01\n";
+  LogReadReport report;
+  LogReader r(text, LogFormat::candump, "big.log", &report, 100000);
+  r.keep_problems(3);
+  std::vector<LogEntry> got;
+  for (LogEntry e; r.next(e);) got.push_back(e);
+  ASSERT_EQ(got.size(), 2u);
+  EXPECT_EQ(got[1].frame.id, 0x124u);
+  EXPECT_EQ(report.dropped, 51u);
+  ASSERT_EQ(report.problems.size(), 3u);
+  EXPECT_EQ(report.problems[0].rfind("big.log:2: line: longer than", 0), 0u) << report.problems[0];
+  EXPECT_EQ(report.problems[1].rfind("big.log:3: candump line", 0), 0u) << report.problems[1];
 }

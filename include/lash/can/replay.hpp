@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <string>
 
@@ -32,6 +33,11 @@ struct ReplayResult {
 
 /// Replays `entries` on `bus`. Throws std::invalid_argument for bad options.
 ReplayResult replay(Bus& bus, std::span<const LogEntry> entries, const ReplayOptions& options,
+                    const std::atomic<bool>& stop);
+/// Replays the frames `next` hands out (false: the end), read as they are needed (a LogReader:
+/// memory bounded whatever the log's length); each is read before the wait for its deadline.
+/// `interrupted` when `stop` was seen before the end.
+ReplayResult replay(Bus& bus, const std::function<bool(LogEntry&)>& next, const ReplayOptions& options,
                     const std::atomic<bool>& stop);
 
 }  // namespace lash::can

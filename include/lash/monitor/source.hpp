@@ -2,9 +2,9 @@
 /// @file source.hpp
 /// Where the monitor's frames come from: a bus (`udp:GROUP:PORT`, `socketcan:IFACE`, `mem:NAME`,
 /// opened by lash::can::open_bus as `lash can dump` does) or a log file (candump, ASC, BLF, TRC
-/// by extension, lash::can). A candump log is streamed line by line (constant memory); ASC, BLF
-/// and TRC logs are read whole by the can module's readers. Lines or objects a reader cannot
-/// parse are counted (garbage()) and skipped. Not real-time code.
+/// by extension, lash::can), read one frame at a time by can::LogReader (bounded memory, a FIFO
+/// works too). Lines or objects a reader cannot parse are counted (garbage()) and skipped. Not
+/// real-time code.
 #include <atomic>
 #include <chrono>
 #include <cstdint>
