@@ -1,6 +1,7 @@
 #include "lash/identify/auto.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cstdlib>
 #include <cmath>
 #include <limits>
@@ -15,13 +16,6 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kRateShare = 0.10;  // dead band on ẏ as a share of the output's typical rate (docs)
-
-double quantile(std::vector<double> x, double q) {
-  if (x.empty()) return 0.0;
-  const auto k = static_cast<std::size_t>(q * static_cast<double>(x.size() - 1));
-  std::nth_element(x.begin(), x.begin() + static_cast<std::ptrdiff_t>(k), x.end());
-  return x[k];
-}
 
 bool uses_guesses(ModelKind m) noexcept { return contains(InputSwitchingSettings::models, m); }
 
@@ -44,6 +38,98 @@ double raw_edge(const AnyEstimator& est, Side s) {
   }
   return kNaN;
 }
+
+/// One order statistic of a sequence seen once, exactly, in bounded memory (Floyd & Rivest's
+/// selection, as median_step in io/table.cpp): a bracket [lo, hi] from a small sample of the
+/// sequence; the pass counts the values below lo, equal to lo, equal to hi and above hi and keeps
+/// only those strictly between; the rank is then found in the counts or among the kept few.
+/// `all`: no bracket (too small a sample): every value is kept, as the reference rule does.
+struct Selection {
+  double lo = 0.0, hi = 0.0;
+  bool all = true;
+  std::size_t n = 0, below = 0, at_lo = 0, at_hi = 0, above = 0;
+  std::vector<double> inside;
+
+  /// Brackets rank q of the sample `s` (sorted here) with a margin of ~4 standard deviations of
+  /// the sample quantile's rank; expects ~`n_expected` values in the pass.
+  void bracket(std::vector<double>& s, double q, std::size_t n_expected) {
+    constexpr std::size_t kMinSample = 256;
+    if (s.size() < kMinSample) return;  // all: keep every value
+    std::sort(s.begin(), s.end());
+    if (std::isnan(s.front()) || std::isnan(s.back())) return;
+    const double m = static_cast<double>(s.size());
+    const double margin = 4.0 * std::sqrt(m * q * (1.0 - q)) + 8.0;
+    const double r = q * (m - 1.0);
+    const auto i_lo = static_cast<std::size_t>(std::max(0.0, r - margin));
+    const auto i_hi = static_cast<std::size_t>(std::min(m - 1.0, r + margin));
+    lo = s[i_lo];
+    hi = s[i_hi];
+    all = false;
+    inside.reserve(static_cast<std::size_t>(static_cast<double>(n_expected) * (static_cast<double>(i_hi - i_lo) + 2.0) / m * 1.25) + 64);
+  }
+  void add(double x) {
+    ++n;
+    if (all || (x > lo && x < hi)) {
+      inside.push_back(x);
+      return;
+    }
+    below += x < lo ? 1 : 0;
+    at_lo += x == lo ? 1 : 0;
+    above += x > hi ? 1 : 0;
+    at_hi += (x == hi && lo < hi) ? 1 : 0;  // lo == hi: a value equal to both counts once
+  }
+  /// The value of rank ⌊q·(n − 1)⌋; NaN when the bracket missed it (or a value was NaN).
+  double value(double q) {
+    if (n == 0) return 0.0;
+    auto r = static_cast<std::size_t>(q * static_cast<double>(n - 1));
+    const auto nth = [&](std::size_t k) {
+      const auto it = inside.begin() + static_cast<std::ptrdiff_t>(k);
+      std::nth_element(inside.begin(), it, inside.end());
+      return *it;
+    };
+    if (all) return nth(r);
+    constexpr double kMiss = std::numeric_limits<double>::quiet_NaN();
+    if (below + at_lo + inside.size() + at_hi + above != n) return kMiss;  // a NaN
+    if (r < below) return kMiss;
+    r -= below;
+    if (r < at_lo) return lo;
+    r -= at_lo;
+    if (r < inside.size()) return nth(r);
+    r -= inside.size();
+    return r < at_hi ? hi : kMiss;
+  }
+};
+
+/// Calls f(v, y) for every pair where both are finite, in order.
+template <class F>
+void for_each_finite(std::span<const double> v, std::span<const double> y, F&& f) {
+  const std::size_t n = std::min(v.size(), y.size());
+  for (std::size_t k = 0; k < n; ++k)
+    if (std::isfinite(v[k]) && std::isfinite(y[k])) f(v[k], y[k]);
+}
+
+/// The sequences analyse_record takes quantiles of, over the finite pairs (v, y) in order, one
+/// value at a time: the last 41 values of y sit in a ring.
+struct Streams {
+  double dt_s;
+  std::array<double, 64> ring{};
+  std::size_t k = 0;  // finite pairs seen
+  /// f(index, value) for index 0 v, 1 y, 2 |Δ²y|, 3 |Δ₄₀y|/(40T), 4 |Δ²y|/T² (same-direction moves)
+  template <class F>
+  void push(double v, double y, F&& f) {
+    ring[k & 63] = y;
+    f(0, v);
+    f(1, y);
+    if (k >= 2) {
+      const double y1 = ring[(k - 1) & 63], y2 = ring[(k - 2) & 63];
+      f(2, std::fabs(y - 2.0 * y1 + y2));
+      const double d1 = y - y1, d0 = y1 - y2;
+      if (d1 * d0 > 0.0) f(4, std::fabs(d1 - d0) / (dt_s * dt_s));
+    }
+    if (k >= 40) f(3, std::fabs(y - ring[(k - 40) & 63]) / (40.0 * dt_s));
+    ++k;
+  }
+};
 
 }  // namespace
 
@@ -68,47 +154,101 @@ EstimatorConfig preset_config(ModelKind model, Preset preset, double dt_s) {
   return preset == Preset::thesis ? EstimatorConfig::thesis(model, dt_s) : EstimatorConfig(model, dt_s);
 }
 
+// The quantiles are exact (the value std::nth_element puts at rank ⌊q·(n − 1)⌋ of a full copy of
+// the sequence), in memory of a few per cent of the record: see Selection and
+// docs/identification.md ("Defaults chosen from the data").
 DataTraits analyse_record(std::span<const double> v, std::span<const double> y, double dt_s) {
   DataTraits d;
   d.dt_s = dt_s;
-  std::vector<double> vf, yf, d2, steps;
-  vf.reserve(v.size());
-  yf.reserve(y.size());
-  for (std::size_t k = 0; k < v.size() && k < y.size(); ++k)
-    if (std::isfinite(v[k]) && std::isfinite(y[k])) {
-      vf.push_back(v[k]);
-      yf.push_back(y[k]);
-    }
-  d.samples = vf.size();
-  if (vf.size() < 3) return d;
-  d.v_lo = quantile(vf, 0.001);
-  d.v_hi = quantile(vf, 0.999);
-  d.y_span = quantile(yf, 0.999) - quantile(yf, 0.001);
-  d2.reserve(yf.size());
-  for (std::size_t k = 2; k < yf.size(); ++k) d2.push_back(std::fabs(yf[k] - 2.0 * yf[k - 1] + yf[k - 2]));
-  d.noise_sigma = quantile(d2, 0.5) / (0.6745 * std::sqrt(6.0));
+  const std::size_t n = std::min(v.size(), y.size());
+  // The five sequences' quantiles (index of the sequence, q)
+  constexpr std::array<std::pair<int, double>, 7> kQ{{{0, 0.001}, {0, 0.999}, {1, 0.001}, {1, 0.999},
+                                                      {2, 0.5}, {3, 0.9}, {4, 0.9}}};
+  std::array<Selection, 7> sel;
   {
-    std::vector<double> rates;
-    rates.reserve(yf.size());
-    for (std::size_t k = 40; k < yf.size(); ++k) rates.push_back(std::fabs(yf[k] - yf[k - 40]) / (40.0 * dt_s));
-    d.ydot_p90 = quantile(rates, 0.9);
-    std::vector<double> acc;
-    for (std::size_t k = 2; k < yf.size(); ++k) {
-      const double d1 = yf[k] - yf[k - 1], d0 = yf[k - 1] - yf[k - 2];
-      if (d1 * d0 > 0.0) acc.push_back(std::fabs(d1 - d0) / (dt_s * dt_s));
+    // A sample of each sequence at up to kSample evenly spaced rows (rows with a non-finite
+    // value are passed over: the sample only places the brackets, the pass decides)
+    constexpr std::size_t kSample = 4096;
+    std::array<std::vector<double>, 5> smp;
+    if (n >= 4 * kSample) {
+      const std::size_t stride = n / kSample;
+      for (std::size_t j = 0; j < kSample; ++j) {
+        const std::size_t k = j * stride + 40;
+        if (k >= n) break;
+        bool ok = true;
+        for (std::size_t i = k - 40; i <= k; ++i) ok = ok && std::isfinite(v[i]) && std::isfinite(y[i]);
+        if (!ok) continue;
+        Streams s{dt_s};
+        for (std::size_t i = k - 40; i <= k; ++i)
+          s.push(v[i], y[i], [&](int idx, double x) {
+            if (i == k) smp[static_cast<std::size_t>(idx)].push_back(x);
+          });
+      }
     }
-    d.yddot_p90 = quantile(acc, 0.9);
+    for (std::size_t i = 0; i < kQ.size(); ++i) {
+      auto s = smp[static_cast<std::size_t>(kQ[i].first)];
+      sel[i].bracket(s, kQ[i].second, n);
+    }
   }
-  // quantised: the nonzero steps are integer multiples of the smallest one
-  for (std::size_t k = 1; k < yf.size(); ++k) {
-    const double s = std::fabs(yf[k] - yf[k - 1]);
-    if (s > 0.0) steps.push_back(s);
+  // One pass over the record: the selections, and the smallest nonzero step of y
+  Streams st{dt_s};
+  std::size_t n_steps = 0;
+  double min_step = std::numeric_limits<double>::infinity();
+  double y_prev = 0.0;
+  for_each_finite(v, y, [&](double vk, double yk) {
+    if (st.k >= 1) {
+      const double s = std::fabs(yk - y_prev);
+      if (s > 0.0) {
+        ++n_steps;
+        min_step = std::min(min_step, s);
+      }
+    }
+    y_prev = yk;
+    st.push(vk, yk, [&](int idx, double x) {
+      for (std::size_t i = 0; i < kQ.size(); ++i)
+        if (kQ[i].first == idx) sel[i].add(x);
+    });
+  });
+  d.samples = st.k;
+  if (d.samples < 3) return d;
+  std::array<double, 7> val{};
+  for (std::size_t i = 0; i < kQ.size(); ++i) {
+    val[i] = sel[i].value(kQ[i].second);
+    if (std::isnan(val[i]) && !sel[i].all) {
+      // the bracket missed (or a value is NaN): the reference rule on the whole sequence
+      sel[i] = Selection{};
+      Streams s2{dt_s};
+      for_each_finite(v, y, [&](double vk, double yk) {
+        s2.push(vk, yk, [&](int idx, double x) {
+          if (idx == kQ[i].first) sel[i].add(x);
+        });
+      });
+      val[i] = sel[i].value(kQ[i].second);
+    }
+    sel[i] = Selection{};  // free the kept values
   }
-  if (steps.size() > 10) {
-    const double q = *std::min_element(steps.begin(), steps.end());
-    std::size_t on_grid = 0;
-    for (double s : steps) on_grid += std::fabs(s / q - std::round(s / q)) < 1e-3 ? 1u : 0u;
-    if (q > 0.0 && on_grid >= steps.size() * 99 / 100) d.quantum = q;
+  d.v_lo = val[0];
+  d.v_hi = val[1];
+  d.y_span = val[3] - val[2];
+  d.noise_sigma = val[4] / (0.6745 * std::sqrt(6.0));
+  d.ydot_p90 = val[5];
+  d.yddot_p90 = val[6];
+  // quantised: the nonzero steps are integer multiples of the smallest one (99 % of them); the
+  // count stops as soon as more than 1 % are off the grid
+  if (n_steps > 10 && min_step > 0.0) {
+    const double q = min_step;
+    const std::size_t off_allowed = n_steps - n_steps * 99 / 100;
+    std::size_t off = 0, k = 0;
+    const std::size_t n_all = n;
+    for (std::size_t i = 0; i < n_all && off <= off_allowed; ++i) {
+      if (!(std::isfinite(v[i]) && std::isfinite(y[i]))) continue;
+      if (k++ >= 1) {
+        const double s = std::fabs(y[i] - y_prev);
+        if (s > 0.0) off += std::fabs(s / q - std::round(s / q)) < 1e-3 ? 0u : 1u;
+      }
+      y_prev = y[i];
+    }
+    if (off <= off_allowed) d.quantum = q;
   }
   return d;
 }
