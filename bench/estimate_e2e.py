@@ -28,16 +28,17 @@ a = ap.parse_args()
 
 
 def timed(cmd):
-    """wall time [s], peak RSS [bytes] (this child alone: run in a fresh helper), stdout, stderr"""
+    """wall time [s], CPU time (user + system) [s], peak RSS [bytes] of the child (run from a fresh
+    helper process, so that getrusage(RUSAGE_CHILDREN) sees this child alone), stdout, stderr"""
     wrapper = ("import resource,subprocess,sys,time;t=time.perf_counter();"
                "p=subprocess.run(sys.argv[1:],capture_output=True,text=True);w=time.perf_counter()-t;"
-               "sys.stdout.write(p.stdout);sys.stderr.write(p.stderr);"
-               "print('@@',w,resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss,p.returncode,file=sys.stderr)")
+               "sys.stdout.write(p.stdout);sys.stderr.write(p.stderr);r=resource.getrusage(resource.RUSAGE_CHILDREN);"
+               "print('@@',w,r.ru_utime+r.ru_stime,r.ru_maxrss,p.returncode,file=sys.stderr)")
     p = subprocess.run([sys.executable, "-c", wrapper] + cmd, capture_output=True, text=True)
-    m = re.search(r"@@ (\S+) (\d+) (-?\d+)\s*$", p.stderr)
-    if not m or m.group(3) != "0":
+    m = re.search(r"@@ (\S+) (\S+) (\d+) (-?\d+)\s*$", p.stderr)
+    if not m or m.group(4) != "0":
         sys.exit(f"failed: {' '.join(cmd)}\n{p.stderr}")
-    return float(m.group(1)), int(m.group(2)) * 1024, p.stdout, p.stderr
+    return float(m.group(1)), float(m.group(2)), int(m.group(3)) * 1024, p.stdout, p.stderr
 
 
 with tempfile.TemporaryDirectory() as d:
@@ -47,25 +48,31 @@ with tempfile.TemporaryDirectory() as d:
                         "--amplitude", "600", "--duration", str(a.rows * 0.005), "--noise-variance", "4",
                         "--seed", "1", "-o", csv], check=True, capture_output=True)
     rows = sum(1 for _ in open(csv, "rb")) - 1
-    floor_s, est_s, e2e_s, rss = [], [], [], []
+    runs = {k: [] for k in ("floor", "floor_cpu", "est", "est_cpu", "e2e", "e2e_cpu", "rss", "floor_rss")}
     for _ in range(a.repeat):
-        w, _, out, _ = timed([a.floor, csv])
+        w, c, r, out, _ = timed([a.floor, csv])
         if int(out.split()[1]) != rows:
             sys.exit(f"floor read {out.split()[1]} rows, the file has {rows}")
-        floor_s.append(w)
-        w, r, out, err = timed([a.lash, "estimate", csv, "--model", "deadzone-deadband", "--json", "--timing"])
-        m = re.search(r"estimator ran (\d+) samples in (\S+) s", err)
+        runs["floor"].append(w)
+        runs["floor_cpu"].append(c)
+        runs["floor_rss"].append(r)
+        w, c, r, out, err = timed([a.lash, "estimate", csv, "--model", "deadzone-deadband", "--json", "--timing"])
+        m = re.search(r"estimator ran (\d+) samples in (\S+) s .*CPU time (\S+) s", err)
         if not m or int(m.group(1)) != rows:
             sys.exit(f"no --timing line for {rows} samples: {err}")
-        est_s.append(float(m.group(2)))
-        e2e_s.append(w)
-        rss.append(r)
-    f, e, w, r = (statistics.median(x) for x in (floor_s, est_s, e2e_s, rss))
+        runs["est"].append(float(m.group(2)))
+        runs["est_cpu"].append(float(m.group(3)))
+        runs["e2e"].append(w)
+        runs["e2e_cpu"].append(c)
+        runs["rss"].append(r)
+    md = {k: statistics.median(v) for k, v in runs.items()}
     ns = lambda s: s / rows * 1e9
     needed = 24 * rows
-    print(f"rows {rows} (median of {a.repeat} runs)")
-    print(f"read+parse floor   {ns(f):7.1f} ns/row   ({f:.3f} s)")
-    print(f"estimator alone    {ns(e):7.1f} ns/row   ({e:.3f} s, lash estimate --timing)")
-    print(f"lash estimate      {ns(w):7.1f} ns/row   ({w:.3f} s whole process)")
-    print(f"ratio lash estimate / (floor + estimator) = {w / (f + e):.3f} (goal <= 1.3)")
+    print(f"rows {rows} (median of {a.repeat} runs; wall time, and CPU time, which a loaded machine inflates less)")
+    for what, sfx in (("wall", ""), ("cpu ", "_cpu")):
+        f, e, w = md["floor" + sfx], md["est" + sfx], md["e2e" + sfx]
+        print(f"{what}: floor {ns(f):6.1f} + estimator {ns(e):6.1f} = {ns(f + e):6.1f} ns/row; "
+              f"lash estimate {ns(w):6.1f} ns/row; ratio lash estimate / (floor + estimator) = {w / (f + e):.3f} (goal <= 1.3)")
+    r = md["rss"]
+    print(f"floor peak RSS {md['floor_rss'] / 1e6:.1f} MB")
     print(f"peak RSS {r / 1e6:.1f} MB = {r / needed:.2f} x the needed columns (3 x 8 B x rows = {needed / 1e6:.0f} MB; goal <= 1.3)")

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cstdlib>
+#include <cstdint>
+#include <cstring>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -67,17 +69,65 @@ struct Selection {
     all = false;
     inside.reserve(static_cast<std::size_t>(static_cast<double>(n_expected) * (static_cast<double>(i_hi - i_lo) + 2.0) / m * 1.25) + 64);
   }
-  void add(double x) {
-    ++n;
-    if (all || (x > lo && x < hi)) {
-      inside.push_back(x);
+  /// Counts x[0..m) against the bracket and keeps the values strictly inside it; `buf` has room
+  /// for m values.
+  void add(const double* x, std::size_t m, double* buf) {
+    n += m;
+    if (all) {
+      inside.insert(inside.end(), x, x + m);
       return;
     }
-    below += x < lo ? 1 : 0;
-    at_lo += x == lo ? 1 : 0;
-    above += x > hi ? 1 : 0;
-    at_hi += (x == hi && lo < hi) ? 1 : 0;  // lo == hi: a value equal to both counts once
+    // the counts: two lanes at a time (SSE2's width), without a branch on the data (GCC/Clang
+    // vector extensions: a lane's comparison is −1 where true)
+    using V = double __attribute__((vector_size(16)));
+    using M = std::int64_t __attribute__((vector_size(16)));
+    const double l = lo, h = hi;
+    const V lv = {l, l}, hv = {h, h};
+    M c_lt_lo{}, c_le_lo{}, c_lt_hi{}, c_le_hi{}, c_gt_hi{};
+    std::size_t i = 0;
+    for (; i + 2 <= m; i += 2) {
+      V v;
+      std::memcpy(&v, x + i, sizeof v);
+      c_lt_lo -= v < lv;
+      c_le_lo -= v <= lv;
+      c_lt_hi -= v < hv;
+      c_le_hi -= v <= hv;
+      c_gt_hi -= v > hv;
+    }
+    const auto sum = [](const M& c) { return static_cast<std::size_t>(c[0] + c[1]); };
+    std::size_t lt_lo = sum(c_lt_lo), le_lo = sum(c_le_lo), lt_hi = sum(c_lt_hi), le_hi = sum(c_le_hi),
+                gt_hi = sum(c_gt_hi);
+    for (; i < m; ++i) {
+      const double v = x[i];
+      lt_lo += v < l ? 1 : 0;
+      le_lo += v <= l ? 1 : 0;
+      lt_hi += v < h ? 1 : 0;
+      le_hi += v <= h ? 1 : 0;
+      gt_hi += v > h ? 1 : 0;
+    }
+    below += lt_lo;
+    at_lo += le_lo - lt_lo;
+    at_hi += l < h ? le_hi - lt_hi : 0;  // lo == hi: a value equal to both counts once (at lo)
+    above += gt_hi;
+    if (lt_hi <= le_lo) return;  // none inside
+    const std::size_t count = lt_hi - le_lo;
+    if (count * 32 <= m) {  // few: a branch that is rarely taken, stopped at the last one
+      for (std::size_t j = 0, got = 0; got < count && j < m; ++j)
+        if (x[j] > l && x[j] < h) {
+          inside.push_back(x[j]);
+          ++got;
+        }
+      return;
+    }
+    std::size_t kept = 0;  // many: every value written, the position advanced past those inside
+    for (std::size_t j = 0; j < m; ++j) {
+      const double v = x[j];
+      buf[kept] = v;
+      kept += (v > l) & (v < h) ? 1 : 0;
+    }
+    inside.insert(inside.end(), buf, buf + kept);
   }
+
   /// The value of rank ⌊q·(n − 1)⌋; NaN when the bracket missed it (or a value was NaN).
   double value(double q) {
     if (n == 0) return 0.0;
@@ -99,14 +149,6 @@ struct Selection {
     return r < at_hi ? hi : kMiss;
   }
 };
-
-/// Calls f(v, y) for every pair where both are finite, in order.
-template <class F>
-void for_each_finite(std::span<const double> v, std::span<const double> y, F&& f) {
-  const std::size_t n = std::min(v.size(), y.size());
-  for (std::size_t k = 0; k < n; ++k)
-    if (std::isfinite(v[k]) && std::isfinite(y[k])) f(v[k], y[k]);
-}
 
 /// The sequences analyse_record takes quantiles of, over the finite pairs (v, y) in order, one
 /// value at a time: the last 41 values of y sit in a ring.
@@ -171,10 +213,14 @@ DataTraits analyse_record(std::span<const double> v, std::span<const double> y, 
     constexpr std::size_t kSample = 4096;
     std::array<std::vector<double>, 5> smp;
     if (n >= 4 * kSample) {
-      const std::size_t stride = n / kSample;
+      // one row drawn in each of kSample equal strata (a fixed LCG: deterministic; random, so that
+      // a periodic record cannot alias with the stride)
+      std::uint64_t rng = 0x853c49e6748fea9bULL;
+      const double stratum = static_cast<double>(n - 40) / static_cast<double>(kSample);
       for (std::size_t j = 0; j < kSample; ++j) {
-        const std::size_t k = j * stride + 40;
-        if (k >= n) break;
+        rng = rng * 6364136223846793005ULL + 1442695040888963407ULL;
+        const double u = static_cast<double>(rng >> 11) * 0x1p-53;
+        const std::size_t k = std::min(n - 1, 40 + static_cast<std::size_t>((static_cast<double>(j) + u) * stratum));
         bool ok = true;
         for (std::size_t i = k - 40; i <= k; ++i) ok = ok && std::isfinite(v[i]) && std::isfinite(y[i]);
         if (!ok) continue;
@@ -190,39 +236,82 @@ DataTraits analyse_record(std::span<const double> v, std::span<const double> y, 
       sel[i].bracket(s, kQ[i].second, n);
     }
   }
-  // One pass over the record: the selections, and the smallest nonzero step of y
-  Streams st{dt_s};
+  // One pass over the record in chunks that stay in the L1 cache: the finite pairs of a chunk,
+  // the derived sequences, then each selection counts its sequence's chunk; and the smallest
+  // nonzero step of y. The last 40 finite values of y lead the next chunk's (rates, differences).
+  constexpr std::size_t kChunk = 1024, kLead = 40;
+  std::vector<double> vb(kChunk), yb(kLead + kChunk), d2(kChunk), rate(kChunk), acc(kChunk), buf(kChunk);
   std::size_t n_steps = 0;
   double min_step = std::numeric_limits<double>::infinity();
-  double y_prev = 0.0;
-  for_each_finite(v, y, [&](double vk, double yk) {
-    if (st.k >= 1) {
-      const double s = std::fabs(yk - y_prev);
-      if (s > 0.0) {
-        ++n_steps;
-        min_step = std::min(min_step, s);
+  const double rate_div = 40.0 * dt_s, acc_div = dt_s * dt_s;
+  // the pass over the selections `active` (a bit per selection); returns the count of finite pairs
+  const auto pass = [&](unsigned active, bool first) {
+    std::size_t k = 0;  // finite pairs before the chunk
+    for (std::size_t r = 0; r < n;) {
+      std::size_t m = 0;
+      for (; r < n && m < kChunk; ++r)
+        if (std::isfinite(v[r]) && std::isfinite(y[r])) {
+          vb[m] = v[r];
+          yb[kLead + m] = y[r];
+          ++m;
+        }
+      const double* yc = yb.data() + kLead;  // yc[j] = the (k + j)-th finite y; yc[-40..-1] the ones before
+      // |Δ²y| from finite index 2, |Δ₄₀y|/(40T) from 40, |Δ²y|/T² where y moved the same way twice
+      const std::size_t j2 = k >= 2 ? 0 : std::min(m, 2 - k), j40 = k >= 40 ? 0 : std::min(m, 40 - k);
+      const std::size_t j1 = k >= 1 ? 0 : std::min<std::size_t>(m, 1);
+      std::size_t n_acc = 0;
+      for (std::size_t j = j2; j < m; ++j) {
+        d2[j - j2] = std::fabs(yc[j] - 2.0 * yc[j - 1] + yc[j - 2]);
+        const double e1 = yc[j] - yc[j - 1], e0 = yc[j - 1] - yc[j - 2];
+        acc[n_acc] = std::fabs(e1 - e0) / acc_div;
+        n_acc += e1 * e0 > 0.0 ? 1 : 0;
+      }
+      for (std::size_t j = j40; j < m; ++j) rate[j - j40] = std::fabs(yc[j] - yc[j - 40]) / rate_div;
+      for (std::size_t j = j1; j < m && first; ++j) {
+        const double st = std::fabs(yc[j] - yc[j - 1]);
+        n_steps += st > 0.0 ? 1 : 0;
+        min_step = st > 0.0 ? std::min(min_step, st) : min_step;
+      }
+      const std::array<std::pair<const double*, std::size_t>, 5> seq{
+          {{vb.data(), m}, {yc, m}, {d2.data(), m - j2}, {rate.data(), m - j40}, {acc.data(), n_acc}}};
+      for (std::size_t i = 0; i < kQ.size(); ++i) {
+        if (!(active >> i & 1u)) continue;
+        const auto& [x, len] = seq[static_cast<std::size_t>(kQ[i].first)];
+        sel[i].add(x, len, buf.data());
+      }
+      k += m;
+      if (m > 0) {  // the last 40 finite values of y lead the next chunk
+        const auto from = yb.begin() + static_cast<std::ptrdiff_t>(m);
+        std::copy(from, from + static_cast<std::ptrdiff_t>(kLead), yb.begin());
       }
     }
-    y_prev = yk;
-    st.push(vk, yk, [&](int idx, double x) {
-      for (std::size_t i = 0; i < kQ.size(); ++i)
-        if (kQ[i].first == idx) sel[i].add(x);
-    });
-  });
-  d.samples = st.k;
+    return k;
+  };
+  const std::size_t k = pass(0x7Fu, true);
+  d.samples = k;
   if (d.samples < 3) return d;
   std::array<double, 7> val{};
   for (std::size_t i = 0; i < kQ.size(); ++i) {
     val[i] = sel[i].value(kQ[i].second);
     if (std::isnan(val[i]) && !sel[i].all) {
-      // the bracket missed (or a value is NaN): the reference rule on the whole sequence
-      sel[i] = Selection{};
-      Streams s2{dt_s};
-      for_each_finite(v, y, [&](double vk, double yk) {
-        s2.push(vk, yk, [&](int idx, double x) {
-          if (idx == kQ[i].first) sel[i].add(x);
-        });
-      });
+      // The bracket missed: a second pass keeps the side the rank lies on, [−inf, lo] or
+      // [hi, +inf], when it holds at most a quarter of the values; else (or with a NaN in the
+      // sequence) every value, as the reference rule does.
+      const Selection& s1 = sel[i];
+      const std::size_t r = static_cast<std::size_t>(kQ[i].second * static_cast<double>(s1.n - 1));
+      const bool no_nan = s1.below + s1.at_lo + s1.inside.size() + s1.at_hi + s1.above == s1.n;
+      Selection s2;
+      if (no_nan && r < s1.below && s1.below <= s1.n / 4) {
+        s2.all = false;
+        s2.lo = -std::numeric_limits<double>::infinity();
+        s2.hi = s1.lo;
+      } else if (no_nan && r >= s1.n - s1.above && s1.above <= s1.n / 4) {
+        s2.all = false;
+        s2.lo = s1.hi;
+        s2.hi = std::numeric_limits<double>::infinity();
+      }
+      sel[i] = std::move(s2);
+      pass(1u << i, false);
       val[i] = sel[i].value(kQ[i].second);
     }
     sel[i] = Selection{};  // free the kept values
@@ -238,11 +327,12 @@ DataTraits analyse_record(std::span<const double> v, std::span<const double> y, 
   if (n_steps > 10 && min_step > 0.0) {
     const double q = min_step;
     const std::size_t off_allowed = n_steps - n_steps * 99 / 100;
-    std::size_t off = 0, k = 0;
+    std::size_t off = 0, seen = 0;
+    double y_prev = 0.0;
     const std::size_t n_all = n;
     for (std::size_t i = 0; i < n_all && off <= off_allowed; ++i) {
       if (!(std::isfinite(v[i]) && std::isfinite(y[i]))) continue;
-      if (k++ >= 1) {
+      if (seen++ >= 1) {
         const double s = std::fabs(y[i] - y_prev);
         if (s > 0.0) off += std::fabs(s / q - std::round(s / q)) < 1e-3 ? 0u : 1u;
       }
