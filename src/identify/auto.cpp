@@ -50,7 +50,8 @@ struct Selection {
   double lo = 0.0, hi = 0.0;
   bool all = true;
   std::size_t n = 0, below = 0, at_lo = 0, at_hi = 0, above = 0;
-  std::vector<double> inside;
+  std::vector<double> inside;  ///< the values kept: inside[0, kept) (the rest is room to write into)
+  std::size_t kept = 0;
 
   /// Brackets rank q of the sample `s` (sorted here) with a margin of ~4 standard deviations of
   /// the sample quantile's rank; expects ~`n_expected` values in the pass.
@@ -67,32 +68,48 @@ struct Selection {
     lo = s[i_lo];
     hi = s[i_hi];
     all = false;
-    inside.reserve(static_cast<std::size_t>(static_cast<double>(n_expected) * (static_cast<double>(i_hi - i_lo) + 2.0) / m * 1.25) + 64);
+    inside.resize(static_cast<std::size_t>(static_cast<double>(n_expected) * (static_cast<double>(i_hi - i_lo) + 2.0) / m * 1.25) + 64);
   }
-  /// Counts x[0..m) against the bracket and keeps the values strictly inside it; `buf` has room
-  /// for m values.
-  void add(const double* x, std::size_t m, double* buf) {
+  /// Counts x[0..m) against the bracket and keeps the values strictly inside it.
+  void add(const double* x, std::size_t m) {
     n += m;
     if (all) {
+      inside.resize(kept);
       inside.insert(inside.end(), x, x + m);
+      kept = inside.size();
       return;
     }
-    // the counts: two lanes at a time (SSE2's width), without a branch on the data (GCC/Clang
-    // vector extensions: a lane's comparison is −1 where true)
+    // Blocks of 16 values: the counts two lanes at a time (SSE2's width; GCC/Clang vector
+    // extensions, a lane's comparison is −1 where true) without a branch on the data, and whether
+    // any value of the block lies inside; only such a block is searched for them (for the tail
+    // quantiles nearly none is).
     using V = double __attribute__((vector_size(16)));
     using M = std::int64_t __attribute__((vector_size(16)));
     const double l = lo, h = hi;
     const V lv = {l, l}, hv = {h, h};
     M c_lt_lo{}, c_le_lo{}, c_lt_hi{}, c_le_hi{}, c_gt_hi{};
     std::size_t i = 0;
-    for (; i + 2 <= m; i += 2) {
-      V v;
-      std::memcpy(&v, x + i, sizeof v);
-      c_lt_lo -= v < lv;
-      c_le_lo -= v <= lv;
-      c_lt_hi -= v < hv;
-      c_le_hi -= v <= hv;
-      c_gt_hi -= v > hv;
+    for (; i + 16 <= m; i += 16) {
+      M any{};
+      for (std::size_t j = 0; j < 16; j += 2) {
+        V v;
+        std::memcpy(&v, x + i + j, sizeof v);
+        const M lt_l = v < lv, lt_h = v < hv, le_l = v <= lv;
+        c_lt_lo -= lt_l;
+        c_le_lo -= le_l;
+        c_lt_hi -= lt_h;
+        c_le_hi -= v <= hv;
+        c_gt_hi -= v > hv;
+        any |= lt_h & ~le_l;  // lo < v < hi
+      }
+      if (any[0] | any[1]) {  // every value written at the end, the end advanced past those inside
+        if (inside.size() < kept + 16) inside.resize(std::max<std::size_t>(2 * inside.size(), kept + 1024));
+        double* out = inside.data();
+        for (std::size_t j = i; j < i + 16; ++j) {
+          out[kept] = x[j];
+          kept += (x[j] > l) & (x[j] < h) ? 1 : 0;
+        }
+      }
     }
     const auto sum = [](const M& c) { return static_cast<std::size_t>(c[0] + c[1]); };
     std::size_t lt_lo = sum(c_lt_lo), le_lo = sum(c_le_lo), lt_hi = sum(c_lt_hi), le_hi = sum(c_le_hi),
@@ -104,32 +121,20 @@ struct Selection {
       lt_hi += v < h ? 1 : 0;
       le_hi += v <= h ? 1 : 0;
       gt_hi += v > h ? 1 : 0;
+      if (v > l && v < h) {
+        if (inside.size() <= kept) inside.resize(std::max<std::size_t>(2 * inside.size(), kept + 1024));
+        inside[kept++] = v;
+      }
     }
     below += lt_lo;
     at_lo += le_lo - lt_lo;
     at_hi += l < h ? le_hi - lt_hi : 0;  // lo == hi: a value equal to both counts once (at lo)
     above += gt_hi;
-    if (lt_hi <= le_lo) return;  // none inside
-    const std::size_t count = lt_hi - le_lo;
-    if (count * 32 <= m) {  // few: a branch that is rarely taken, stopped at the last one
-      for (std::size_t j = 0, got = 0; got < count && j < m; ++j)
-        if (x[j] > l && x[j] < h) {
-          inside.push_back(x[j]);
-          ++got;
-        }
-      return;
-    }
-    std::size_t kept = 0;  // many: every value written, the position advanced past those inside
-    for (std::size_t j = 0; j < m; ++j) {
-      const double v = x[j];
-      buf[kept] = v;
-      kept += (v > l) & (v < h) ? 1 : 0;
-    }
-    inside.insert(inside.end(), buf, buf + kept);
   }
 
   /// The value of rank ⌊q·(n − 1)⌋; NaN when the bracket missed it (or a value was NaN).
   double value(double q) {
+    inside.resize(kept);
     if (n == 0) return 0.0;
     auto r = static_cast<std::size_t>(q * static_cast<double>(n - 1));
     const auto nth = [&](std::size_t k) {
@@ -240,7 +245,7 @@ DataTraits analyse_record(std::span<const double> v, std::span<const double> y, 
   // the derived sequences, then each selection counts its sequence's chunk; and the smallest
   // nonzero step of y. The last 40 finite values of y lead the next chunk's (rates, differences).
   constexpr std::size_t kChunk = 1024, kLead = 40;
-  std::vector<double> vb(kChunk), yb(kLead + kChunk), d2(kChunk), rate(kChunk), acc(kChunk), buf(kChunk);
+  std::vector<double> vb(kChunk), yb(kLead + kChunk), d2(kChunk), rate(kChunk), acc(kChunk);
   std::size_t n_steps = 0;
   double min_step = std::numeric_limits<double>::infinity();
   const double rate_div = 40.0 * dt_s, acc_div = dt_s * dt_s;
@@ -277,7 +282,7 @@ DataTraits analyse_record(std::span<const double> v, std::span<const double> y, 
       for (std::size_t i = 0; i < kQ.size(); ++i) {
         if (!(active >> i & 1u)) continue;
         const auto& [x, len] = seq[static_cast<std::size_t>(kQ[i].first)];
-        sel[i].add(x, len, buf.data());
+        sel[i].add(x, len);
       }
       k += m;
       if (m > 0) {  // the last 40 finite values of y lead the next chunk
