@@ -2,6 +2,7 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <memory>
 #include <vector>
 
 #include "lash/plant/plant.hpp"
@@ -32,4 +33,56 @@ void BM_PlantEq34(benchmark::State& state) {
 }
 BENCHMARK(BM_PlantEq34);
 
+/// The floor: the same plant written by hand for this one chain (deadzone c_l = −300, c_r = 200;
+/// first order a1/b1 = −0.96/0.1 right, −0.94/0.15 left; deadband d = 30/50; side from v(k−1)),
+/// the blocks' equations inlined, nothing generic and no per-block outputs kept.
+struct Eq34ByHand {
+  double w = 0.0, u_prev = 0.0, out = 0.0, v_prev = 0.0;
+  double step(double v) noexcept {
+    const bool right = v_prev >= 0.0;
+    const double x = v > 200.0 ? v - 200.0 : v < -300.0 ? v + 300.0 : 0.0;
+    w = -(right ? -0.96 : -0.94) * w + (right ? 0.1 : 0.15) * u_prev;
+    u_prev = x;
+    const double d = right ? 30.0 : 50.0;
+    if (w < out - d) out = w + d;
+    else if (w > out + d) out = w - d;
+    v_prev = v;
+    return out;
+  }
+};
+
+void BM_PlantEq34_Floor(benchmark::State& state) {
+  Eq34ByHand plant;
+  std::vector<double> v(4096);
+  for (std::size_t k = 0; k < v.size(); ++k) v[k] = 600.0 * std::sin(0.005 * static_cast<double>(k) * 3.0);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    double y = plant.step(v[i]);
+    benchmark::DoNotOptimize(y);
+    i = (i + 1) & 4095;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_PlantEq34_Floor);
+
+}  // namespace
+
+namespace {
+// The hand-written step with its state kept in memory between calls (an object that outlives
+// the call, as any plant object's state does): the floor's own cost once the recurrence goes
+// through a store and a load per step.
+void BM_PlantEq34_FloorInMemory(benchmark::State& state) {
+  auto plant = std::make_unique<Eq34ByHand>();
+  benchmark::DoNotOptimize(plant.get());
+  std::vector<double> v(4096);
+  for (std::size_t k = 0; k < v.size(); ++k) v[k] = 600.0 * std::sin(0.005 * static_cast<double>(k) * 3.0);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    double y = plant->step(v[i]);
+    benchmark::DoNotOptimize(y);
+    i = (i + 1) & 4095;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_PlantEq34_FloorInMemory);
 }  // namespace

@@ -61,8 +61,9 @@ int run(const CLI::App& sub, const EstimateOptions& o) {
   const ArrayEstimate e = estimate_arrays(src, rec.t(), rec.v(), rec.y(), eo);
   const EstimationRun& run = e.run.run;
   if (o.timing)
-    fmt::print(stderr, "lash estimate: estimator ran {} samples in {} s ({:.3g} M samples/s)\n", rec.v().size(),
-               format_double(e.estimator_s), static_cast<double>(rec.v().size()) / e.estimator_s * 1e-6);
+    fmt::print(stderr, "lash estimate: estimator ran {} samples in {} s ({:.3g} M samples/s; CPU time {} s)\n",
+               rec.v().size(), format_double(e.estimator_s), static_cast<double>(rec.v().size()) / e.estimator_s * 1e-6,
+               format_double(e.estimator_cpu_s));
   const auto& t = rec.t();
   if (o.print_config) {
     fmt::print("{}", config_to_toml(e.run.cfg, &e.job));

@@ -1,7 +1,10 @@
 #include "lash/identify/auto.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cstdlib>
+#include <cstdint>
+#include <cstring>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -15,13 +18,6 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kRateShare = 0.10;  // dead band on ẏ as a share of the output's typical rate (docs)
-
-double quantile(std::vector<double> x, double q) {
-  if (x.empty()) return 0.0;
-  const auto k = static_cast<std::size_t>(q * static_cast<double>(x.size() - 1));
-  std::nth_element(x.begin(), x.begin() + static_cast<std::ptrdiff_t>(k), x.end());
-  return x[k];
-}
 
 bool uses_guesses(ModelKind m) noexcept { return contains(InputSwitchingSettings::models, m); }
 
@@ -44,6 +40,143 @@ double raw_edge(const AnyEstimator& est, Side s) {
   }
   return kNaN;
 }
+
+/// One order statistic of a sequence seen once, exactly, in bounded memory (Floyd & Rivest's
+/// selection, as median_step in io/table.cpp): a bracket [lo, hi] from a small sample of the
+/// sequence; the pass counts the values below lo, equal to lo, equal to hi and above hi and keeps
+/// only those strictly between; the rank is then found in the counts or among the kept few.
+/// `all`: no bracket (too small a sample): every value is kept, as the reference rule does.
+struct Selection {
+  double lo = 0.0, hi = 0.0;
+  bool all = true;
+  std::size_t n = 0, below = 0, at_lo = 0, at_hi = 0, above = 0;
+  std::vector<double> inside;  ///< the values kept: inside[0, kept) (the rest is room to write into)
+  std::size_t kept = 0;
+
+  /// Brackets rank q of the sample `s` (sorted here) with a margin of ~4 standard deviations of
+  /// the sample quantile's rank; expects ~`n_expected` values in the pass.
+  void bracket(std::vector<double>& s, double q, std::size_t n_expected) {
+    constexpr std::size_t kMinSample = 256;
+    if (s.size() < kMinSample) return;  // all: keep every value
+    std::sort(s.begin(), s.end());
+    if (std::isnan(s.front()) || std::isnan(s.back())) return;
+    const double m = static_cast<double>(s.size());
+    const double margin = 4.0 * std::sqrt(m * q * (1.0 - q)) + 8.0;
+    const double r = q * (m - 1.0);
+    const auto i_lo = static_cast<std::size_t>(std::max(0.0, r - margin));
+    const auto i_hi = static_cast<std::size_t>(std::min(m - 1.0, r + margin));
+    lo = s[i_lo];
+    hi = s[i_hi];
+    all = false;
+    inside.resize(static_cast<std::size_t>(static_cast<double>(n_expected) * (static_cast<double>(i_hi - i_lo) + 2.0) / m * 1.25) + 64);
+  }
+  /// Counts x[0..m) against the bracket and keeps the values strictly inside it.
+  void add(const double* x, std::size_t m) {
+    n += m;
+    if (all) {
+      inside.resize(kept);
+      inside.insert(inside.end(), x, x + m);
+      kept = inside.size();
+      return;
+    }
+    // Blocks of 16 values: the counts two lanes at a time (SSE2's width; GCC/Clang vector
+    // extensions, a lane's comparison is −1 where true) without a branch on the data, and whether
+    // any value of the block lies inside; only such a block is searched for them (for the tail
+    // quantiles nearly none is).
+    using V = double __attribute__((vector_size(16)));
+    using M = std::int64_t __attribute__((vector_size(16)));
+    const double l = lo, h = hi;
+    const V lv = {l, l}, hv = {h, h};
+    M c_lt_lo{}, c_le_lo{}, c_lt_hi{}, c_le_hi{}, c_gt_hi{};
+    std::size_t i = 0;
+    for (; i + 16 <= m; i += 16) {
+      M any{};
+      for (std::size_t j = 0; j < 16; j += 2) {
+        V v;
+        std::memcpy(&v, x + i + j, sizeof v);
+        const M lt_l = v < lv, lt_h = v < hv, le_l = v <= lv;
+        c_lt_lo -= lt_l;
+        c_le_lo -= le_l;
+        c_lt_hi -= lt_h;
+        c_le_hi -= v <= hv;
+        c_gt_hi -= v > hv;
+        any |= lt_h & ~le_l;  // lo < v < hi
+      }
+      if (any[0] | any[1]) {  // every value written at the end, the end advanced past those inside
+        if (inside.size() < kept + 16) inside.resize(std::max<std::size_t>(2 * inside.size(), kept + 1024));
+        double* out = inside.data();
+        for (std::size_t j = i; j < i + 16; ++j) {
+          out[kept] = x[j];
+          kept += (x[j] > l) & (x[j] < h) ? 1 : 0;
+        }
+      }
+    }
+    const auto sum = [](const M& c) { return static_cast<std::size_t>(c[0] + c[1]); };
+    std::size_t lt_lo = sum(c_lt_lo), le_lo = sum(c_le_lo), lt_hi = sum(c_lt_hi), le_hi = sum(c_le_hi),
+                gt_hi = sum(c_gt_hi);
+    for (; i < m; ++i) {
+      const double v = x[i];
+      lt_lo += v < l ? 1 : 0;
+      le_lo += v <= l ? 1 : 0;
+      lt_hi += v < h ? 1 : 0;
+      le_hi += v <= h ? 1 : 0;
+      gt_hi += v > h ? 1 : 0;
+      if (v > l && v < h) {
+        if (inside.size() <= kept) inside.resize(std::max<std::size_t>(2 * inside.size(), kept + 1024));
+        inside[kept++] = v;
+      }
+    }
+    below += lt_lo;
+    at_lo += le_lo - lt_lo;
+    at_hi += l < h ? le_hi - lt_hi : 0;  // lo == hi: a value equal to both counts once (at lo)
+    above += gt_hi;
+  }
+
+  /// The value of rank ⌊q·(n − 1)⌋; NaN when the bracket missed it (or a value was NaN).
+  double value(double q) {
+    inside.resize(kept);
+    if (n == 0) return 0.0;
+    auto r = static_cast<std::size_t>(q * static_cast<double>(n - 1));
+    const auto nth = [&](std::size_t k) {
+      const auto it = inside.begin() + static_cast<std::ptrdiff_t>(k);
+      std::nth_element(inside.begin(), it, inside.end());
+      return *it;
+    };
+    if (all) return nth(r);
+    constexpr double kMiss = std::numeric_limits<double>::quiet_NaN();
+    if (below + at_lo + inside.size() + at_hi + above != n) return kMiss;  // a NaN
+    if (r < below) return kMiss;
+    r -= below;
+    if (r < at_lo) return lo;
+    r -= at_lo;
+    if (r < inside.size()) return nth(r);
+    r -= inside.size();
+    return r < at_hi ? hi : kMiss;
+  }
+};
+
+/// The sequences analyse_record takes quantiles of, over the finite pairs (v, y) in order, one
+/// value at a time: the last 41 values of y sit in a ring.
+struct Streams {
+  double dt_s;
+  std::array<double, 64> ring{};
+  std::size_t k = 0;  // finite pairs seen
+  /// f(index, value) for index 0 v, 1 y, 2 |Δ²y|, 3 |Δ₄₀y|/(40T), 4 |Δ²y|/T² (same-direction moves)
+  template <class F>
+  void push(double v, double y, F&& f) {
+    ring[k & 63] = y;
+    f(0, v);
+    f(1, y);
+    if (k >= 2) {
+      const double y1 = ring[(k - 1) & 63], y2 = ring[(k - 2) & 63];
+      f(2, std::fabs(y - 2.0 * y1 + y2));
+      const double d1 = y - y1, d0 = y1 - y2;
+      if (d1 * d0 > 0.0) f(4, std::fabs(d1 - d0) / (dt_s * dt_s));
+    }
+    if (k >= 40) f(3, std::fabs(y - ring[(k - 40) & 63]) / (40.0 * dt_s));
+    ++k;
+  }
+};
 
 }  // namespace
 
@@ -68,47 +201,149 @@ EstimatorConfig preset_config(ModelKind model, Preset preset, double dt_s) {
   return preset == Preset::thesis ? EstimatorConfig::thesis(model, dt_s) : EstimatorConfig(model, dt_s);
 }
 
+// The quantiles are exact (the value std::nth_element puts at rank ⌊q·(n − 1)⌋ of a full copy of
+// the sequence), in memory of a few per cent of the record: see Selection and
+// docs/identification.md ("Defaults chosen from the data").
 DataTraits analyse_record(std::span<const double> v, std::span<const double> y, double dt_s) {
   DataTraits d;
   d.dt_s = dt_s;
-  std::vector<double> vf, yf, d2, steps;
-  vf.reserve(v.size());
-  yf.reserve(y.size());
-  for (std::size_t k = 0; k < v.size() && k < y.size(); ++k)
-    if (std::isfinite(v[k]) && std::isfinite(y[k])) {
-      vf.push_back(v[k]);
-      yf.push_back(y[k]);
-    }
-  d.samples = vf.size();
-  if (vf.size() < 3) return d;
-  d.v_lo = quantile(vf, 0.001);
-  d.v_hi = quantile(vf, 0.999);
-  d.y_span = quantile(yf, 0.999) - quantile(yf, 0.001);
-  d2.reserve(yf.size());
-  for (std::size_t k = 2; k < yf.size(); ++k) d2.push_back(std::fabs(yf[k] - 2.0 * yf[k - 1] + yf[k - 2]));
-  d.noise_sigma = quantile(d2, 0.5) / (0.6745 * std::sqrt(6.0));
+  const std::size_t n = std::min(v.size(), y.size());
+  // The five sequences' quantiles (index of the sequence, q)
+  constexpr std::array<std::pair<int, double>, 7> kQ{{{0, 0.001}, {0, 0.999}, {1, 0.001}, {1, 0.999},
+                                                      {2, 0.5}, {3, 0.9}, {4, 0.9}}};
+  std::array<Selection, 7> sel;
   {
-    std::vector<double> rates;
-    rates.reserve(yf.size());
-    for (std::size_t k = 40; k < yf.size(); ++k) rates.push_back(std::fabs(yf[k] - yf[k - 40]) / (40.0 * dt_s));
-    d.ydot_p90 = quantile(rates, 0.9);
-    std::vector<double> acc;
-    for (std::size_t k = 2; k < yf.size(); ++k) {
-      const double d1 = yf[k] - yf[k - 1], d0 = yf[k - 1] - yf[k - 2];
-      if (d1 * d0 > 0.0) acc.push_back(std::fabs(d1 - d0) / (dt_s * dt_s));
+    // A sample of each sequence at up to kSample evenly spaced rows (rows with a non-finite
+    // value are passed over: the sample only places the brackets, the pass decides)
+    constexpr std::size_t kSample = 4096;
+    std::array<std::vector<double>, 5> smp;
+    if (n >= 4 * kSample) {
+      // one row drawn in each of kSample equal strata (a fixed LCG: deterministic; random, so that
+      // a periodic record cannot alias with the stride)
+      std::uint64_t rng = 0x853c49e6748fea9bULL;
+      const double stratum = static_cast<double>(n - 40) / static_cast<double>(kSample);
+      for (std::size_t j = 0; j < kSample; ++j) {
+        rng = rng * 6364136223846793005ULL + 1442695040888963407ULL;
+        const double u = static_cast<double>(rng >> 11) * 0x1p-53;
+        const std::size_t k = std::min(n - 1, 40 + static_cast<std::size_t>((static_cast<double>(j) + u) * stratum));
+        bool ok = true;
+        for (std::size_t i = k - 40; i <= k; ++i) ok = ok && std::isfinite(v[i]) && std::isfinite(y[i]);
+        if (!ok) continue;
+        Streams s{dt_s};
+        for (std::size_t i = k - 40; i <= k; ++i)
+          s.push(v[i], y[i], [&](int idx, double x) {
+            if (i == k) smp[static_cast<std::size_t>(idx)].push_back(x);
+          });
+      }
     }
-    d.yddot_p90 = quantile(acc, 0.9);
+    for (std::size_t i = 0; i < kQ.size(); ++i) {
+      auto s = smp[static_cast<std::size_t>(kQ[i].first)];
+      sel[i].bracket(s, kQ[i].second, n);
+    }
   }
-  // quantised: the nonzero steps are integer multiples of the smallest one
-  for (std::size_t k = 1; k < yf.size(); ++k) {
-    const double s = std::fabs(yf[k] - yf[k - 1]);
-    if (s > 0.0) steps.push_back(s);
+  // One pass over the record in chunks that stay in the L1 cache: the finite pairs of a chunk,
+  // the derived sequences, then each selection counts its sequence's chunk; and the smallest
+  // nonzero step of y. The last 40 finite values of y lead the next chunk's (rates, differences).
+  constexpr std::size_t kChunk = 1024, kLead = 40;
+  std::vector<double> vb(kChunk), yb(kLead + kChunk), d2(kChunk), rate(kChunk), acc(kChunk);
+  std::size_t n_steps = 0;
+  double min_step = std::numeric_limits<double>::infinity();
+  const double rate_div = 40.0 * dt_s, acc_div = dt_s * dt_s;
+  // the pass over the selections `active` (a bit per selection); returns the count of finite pairs
+  const auto pass = [&](unsigned active, bool first) {
+    std::size_t k = 0;  // finite pairs before the chunk
+    for (std::size_t r = 0; r < n;) {
+      std::size_t m = 0;
+      for (; r < n && m < kChunk; ++r)
+        if (std::isfinite(v[r]) && std::isfinite(y[r])) {
+          vb[m] = v[r];
+          yb[kLead + m] = y[r];
+          ++m;
+        }
+      const double* yc = yb.data() + kLead;  // yc[j] = the (k + j)-th finite y; yc[-40..-1] the ones before
+      // |Δ²y| from finite index 2, |Δ₄₀y|/(40T) from 40, |Δ²y|/T² where y moved the same way twice
+      const std::size_t j2 = k >= 2 ? 0 : std::min(m, 2 - k), j40 = k >= 40 ? 0 : std::min(m, 40 - k);
+      const std::size_t j1 = k >= 1 ? 0 : std::min<std::size_t>(m, 1);
+      std::size_t n_acc = 0;
+      for (std::size_t j = j2; j < m; ++j) {
+        d2[j - j2] = std::fabs(yc[j] - 2.0 * yc[j - 1] + yc[j - 2]);
+        const double e1 = yc[j] - yc[j - 1], e0 = yc[j - 1] - yc[j - 2];
+        acc[n_acc] = std::fabs(e1 - e0) / acc_div;
+        n_acc += e1 * e0 > 0.0 ? 1 : 0;
+      }
+      for (std::size_t j = j40; j < m; ++j) rate[j - j40] = std::fabs(yc[j] - yc[j - 40]) / rate_div;
+      for (std::size_t j = j1; j < m && first; ++j) {
+        const double st = std::fabs(yc[j] - yc[j - 1]);
+        n_steps += st > 0.0 ? 1 : 0;
+        min_step = st > 0.0 ? std::min(min_step, st) : min_step;
+      }
+      const std::array<std::pair<const double*, std::size_t>, 5> seq{
+          {{vb.data(), m}, {yc, m}, {d2.data(), m - j2}, {rate.data(), m - j40}, {acc.data(), n_acc}}};
+      for (std::size_t i = 0; i < kQ.size(); ++i) {
+        if (!(active >> i & 1u)) continue;
+        const auto& [x, len] = seq[static_cast<std::size_t>(kQ[i].first)];
+        sel[i].add(x, len);
+      }
+      k += m;
+      if (m > 0) {  // the last 40 finite values of y lead the next chunk
+        const auto from = yb.begin() + static_cast<std::ptrdiff_t>(m);
+        std::copy(from, from + static_cast<std::ptrdiff_t>(kLead), yb.begin());
+      }
+    }
+    return k;
+  };
+  const std::size_t k = pass(0x7Fu, true);
+  d.samples = k;
+  if (d.samples < 3) return d;
+  std::array<double, 7> val{};
+  for (std::size_t i = 0; i < kQ.size(); ++i) {
+    val[i] = sel[i].value(kQ[i].second);
+    if (std::isnan(val[i]) && !sel[i].all) {
+      // The bracket missed: a second pass keeps the side the rank lies on, [−inf, lo] or
+      // [hi, +inf], when it holds at most a quarter of the values; else (or with a NaN in the
+      // sequence) every value, as the reference rule does.
+      const Selection& s1 = sel[i];
+      const std::size_t r = static_cast<std::size_t>(kQ[i].second * static_cast<double>(s1.n - 1));
+      const bool no_nan = s1.below + s1.at_lo + s1.inside.size() + s1.at_hi + s1.above == s1.n;
+      Selection s2;
+      if (no_nan && r < s1.below && s1.below <= s1.n / 4) {
+        s2.all = false;
+        s2.lo = -std::numeric_limits<double>::infinity();
+        s2.hi = s1.lo;
+      } else if (no_nan && r >= s1.n - s1.above && s1.above <= s1.n / 4) {
+        s2.all = false;
+        s2.lo = s1.hi;
+        s2.hi = std::numeric_limits<double>::infinity();
+      }
+      sel[i] = std::move(s2);
+      pass(1u << i, false);
+      val[i] = sel[i].value(kQ[i].second);
+    }
+    sel[i] = Selection{};  // free the kept values
   }
-  if (steps.size() > 10) {
-    const double q = *std::min_element(steps.begin(), steps.end());
-    std::size_t on_grid = 0;
-    for (double s : steps) on_grid += std::fabs(s / q - std::round(s / q)) < 1e-3 ? 1u : 0u;
-    if (q > 0.0 && on_grid >= steps.size() * 99 / 100) d.quantum = q;
+  d.v_lo = val[0];
+  d.v_hi = val[1];
+  d.y_span = val[3] - val[2];
+  d.noise_sigma = val[4] / (0.6745 * std::sqrt(6.0));
+  d.ydot_p90 = val[5];
+  d.yddot_p90 = val[6];
+  // quantised: the nonzero steps are integer multiples of the smallest one (99 % of them); the
+  // count stops as soon as more than 1 % are off the grid
+  if (n_steps > 10 && min_step > 0.0) {
+    const double q = min_step;
+    const std::size_t off_allowed = n_steps - n_steps * 99 / 100;
+    std::size_t off = 0, seen = 0;
+    double y_prev = 0.0;
+    const std::size_t n_all = n;
+    for (std::size_t i = 0; i < n_all && off <= off_allowed; ++i) {
+      if (!(std::isfinite(v[i]) && std::isfinite(y[i]))) continue;
+      if (seen++ >= 1) {
+        const double s = std::fabs(y[i] - y_prev);
+        if (s > 0.0) off += std::fabs(s / q - std::round(s / q)) < 1e-3 ? 0u : 1u;
+      }
+      y_prev = y[i];
+    }
+    if (off <= off_allowed) d.quantum = q;
   }
   return d;
 }

@@ -261,6 +261,20 @@ class TextReader {
     int bad_slot = -1;
     for (std::size_t f = 0; f <= last_field_; ++f) {
       const char* fe;
+      // fast path: a chosen field that is a plain finite number ending at the separator (or the
+      // line's end) is read in place, without finding the separator first
+      if (sep_ != 0 && slot_of_field_[f] >= 0) {
+        double v;
+        const auto r = std::from_chars(p, e, v);
+        if (r.ec == std::errc() && (r.ptr == e || *r.ptr == sep_) && std::isfinite(v)) {
+          vals_[static_cast<std::size_t>(slot_of_field_[f])] = v;
+          if (f < last_field_) {
+            if (r.ptr == e) too_few(f + 1);
+            p = r.ptr + 1;
+          }
+          continue;
+        }
+      }
       if (sep_ == 0) {
         while (p < e && is_blank(*p)) ++p;
         if (p == e) too_few(f);

@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
+#include <numbers>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -712,6 +715,89 @@ TEST(Estimators, CoupledCartsSquareWaveIsNotIdentified) {
   }
   EXPECT_FALSE(e.identified());
   EXPECT_EQ(sim_max, 0.0);  // nothing identified: the free run (position) predicts no motion
+}
+
+}  // namespace
+}  // namespace lash
+
+namespace lash {
+namespace {
+
+// analyse_record's quantiles are selected in one pass from a bracket placed by a sample
+// (auto.cpp); the reference here copies every sequence and takes std::nth_element's value at rank
+// ⌊q·(n − 1)⌋ (the rule analyse_record documents). Equal to the bit on records that exercise the
+// bracket (n ≥ 16384): noise, a sine input whose period could alias a strided sample, a quantised
+// output (ties at the bracket's ends), non-finite rows and an output that does not move.
+DataTraits analyse_reference(const std::vector<double>& v, const std::vector<double>& y, double dt) {
+  const auto quantile = [](std::vector<double> x, double q) {
+    if (x.empty()) return 0.0;
+    const auto k = static_cast<std::size_t>(q * static_cast<double>(x.size() - 1));
+    std::nth_element(x.begin(), x.begin() + static_cast<std::ptrdiff_t>(k), x.end());
+    return x[k];
+  };
+  DataTraits d;
+  d.dt_s = dt;
+  std::vector<double> vf, yf, d2, rates, acc, steps;
+  for (std::size_t k = 0; k < v.size(); ++k)
+    if (std::isfinite(v[k]) && std::isfinite(y[k])) {
+      vf.push_back(v[k]);
+      yf.push_back(y[k]);
+    }
+  d.samples = vf.size();
+  if (vf.size() < 3) return d;
+  d.v_lo = quantile(vf, 0.001);
+  d.v_hi = quantile(vf, 0.999);
+  d.y_span = quantile(yf, 0.999) - quantile(yf, 0.001);
+  for (std::size_t k = 2; k < yf.size(); ++k) d2.push_back(std::fabs(yf[k] - 2.0 * yf[k - 1] + yf[k - 2]));
+  d.noise_sigma = quantile(d2, 0.5) / (0.6745 * std::sqrt(6.0));
+  for (std::size_t k = 40; k < yf.size(); ++k) rates.push_back(std::fabs(yf[k] - yf[k - 40]) / (40.0 * dt));
+  d.ydot_p90 = quantile(rates, 0.9);
+  for (std::size_t k = 2; k < yf.size(); ++k) {
+    const double d1 = yf[k] - yf[k - 1], d0 = yf[k - 1] - yf[k - 2];
+    if (d1 * d0 > 0.0) acc.push_back(std::fabs(d1 - d0) / (dt * dt));
+  }
+  d.yddot_p90 = quantile(acc, 0.9);
+  for (std::size_t k = 1; k < yf.size(); ++k)
+    if (const double s = std::fabs(yf[k] - yf[k - 1]); s > 0.0) steps.push_back(s);
+  if (steps.size() > 10) {
+    const double q = *std::min_element(steps.begin(), steps.end());
+    std::size_t on = 0;
+    for (double s : steps) on += std::fabs(s / q - std::round(s / q)) < 1e-3 ? 1u : 0u;
+    if (on >= steps.size() * 99 / 100) d.quantum = q;
+  }
+  return d;
+}
+
+void expect_same_traits(const DataTraits& a, const DataTraits& b, const char* what) {
+  SCOPED_TRACE(what);
+  EXPECT_EQ(a.samples, b.samples);
+  for (auto [x, r] : {std::pair{a.v_lo, b.v_lo}, {a.v_hi, b.v_hi}, {a.y_span, b.y_span}, {a.noise_sigma, b.noise_sigma},
+                      {a.ydot_p90, b.ydot_p90}, {a.yddot_p90, b.yddot_p90}, {a.quantum, b.quantum}})
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(x), std::bit_cast<std::uint64_t>(r)) << x << " vs " << r;
+}
+
+TEST(AnalyseRecord, QuantilesEqualFullCopiesToTheBit) {
+  Rng rng(42);
+  const std::size_t n = 200'000;
+  std::vector<double> v(n), y(n), yq(n), yflat(n, 1.5);
+  double w = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    v[k] = 600.0 * std::sin(2.0 * std::numbers::pi * static_cast<double>(k) / 1000.0);  // period 1000 rows
+    w = 0.96 * w + 0.1 * v[k];
+    y[k] = w + 0.5 * rng.gaussian();
+    yq[k] = std::round(w / 0.25) * 0.25;  // an encoder: steps of 0.25, many ties
+  }
+  expect_same_traits(analyse_record(v, y, 0.005), analyse_reference(v, y, 0.005), "sine and noise");
+  expect_same_traits(analyse_record(v, yq, 0.001), analyse_reference(v, yq, 0.001), "quantised");
+  expect_same_traits(analyse_record(v, yflat, 0.005), analyse_reference(v, yflat, 0.005), "flat output");
+  std::vector<double> vn = v, yn = y;
+  for (std::size_t k = 7; k < n; k += 997) vn[k] = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t k = 11; k < n; k += 1301) yn[k] = std::numeric_limits<double>::infinity();
+  expect_same_traits(analyse_record(vn, yn, 0.005), analyse_reference(vn, yn, 0.005), "non-finite rows");
+  std::vector<double> vr(n);
+  for (auto& x : vr) x = rng.gaussian() * 100.0;
+  expect_same_traits(analyse_record(vr, y, 0.002), analyse_reference(vr, y, 0.002), "white input");
+  EXPECT_GT(analyse_record(v, yq, 0.001).quantum, 0.0);  // the encoder step is found
 }
 
 }  // namespace

@@ -68,6 +68,7 @@ struct ArrayEstimate {
   EstimationJob job;      ///< the job part of the resolved settings (columns, NRMSE window)
   ReportFit fit;          ///< the fit part of the report (NRMSE, window, skipped rows, gaps, median step)
   double estimator_s = 0.0;  ///< wall time of estimate_auto alone [s] (`lash estimate --timing`)
+  double estimator_cpu_s = 0.0;  ///< CPU time of the calling thread in estimate_auto [s] (`--timing`)
   std::string json;       ///< what `lash estimate --json` prints (estimate_auto_json)
 };
 
