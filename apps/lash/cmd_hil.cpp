@@ -54,8 +54,8 @@ CLI::Option* add_duration(CLI::App* sub, double& value, const std::string& what)
   const double max_s = static_cast<double>(hil::kMaxSteps) * 5e-3;
   return sub
       ->add_option("--duration", value,
-                   what + " [s], > 0; at most " + std::to_string(hil::kMaxSteps) +
-                       " steps (logs are preallocated: " + format_double(max_s) + " s at 5 ms)")
+                   what + " [s], > 0; at most " + std::to_string(hil::kMaxSteps) + " steps (" +
+                       format_double(max_s) + " s at 5 ms; the logs are streamed to disk)")
       ->check(CLI::PositiveNumber);
 }
 

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cmd_hil.hpp"
+#include "lash/can/log.hpp"
 #include "lash/rt/dma_latency.hpp"
 
 namespace lash::cli::hilcli {
@@ -52,6 +53,12 @@ void warn_all(const char* who, const std::vector<std::string>& warnings) {
   for (const auto& w : warnings) fmt::print(stderr, "lash hil {}: warning: {}\n", who, w);
 }
 
+void warn_ring(const char* who, const hil::LogStats& l) {
+  if (l.ring_full > 0)
+    fmt::print(stderr, "lash hil {}: warning: the log writer fell behind: {} log items were not written (ring full)\n",
+               who, l.ring_full);
+}
+
 int run_slave(const SlaveOptions& o) {
   hil::BenchSettings s = load_settings(o.common);
   if (o.seed >= 0) s.plant.seed = static_cast<std::uint64_t>(o.seed);
@@ -59,6 +66,8 @@ int run_slave(const SlaveOptions& o) {
   ro.loop = loop_options(o.common, s);
   ro.duration_s = o.duration;
   ro.connect_timeout_s = o.connect_timeout;
+  ro.logs.csv = o.log;
+  ro.logs.events = std::filesystem::path(o.log).replace_extension("").string() + ".events.csv";
   (void)hil::steps_for(o.duration, s.step_s, "--duration");
   hil::install_node_signal_handlers();
   const hil::SlaveRun r = hil::run_slave_node(s, ro, hil::node_stop_flag(), [&](const std::string& address) {
@@ -75,17 +84,15 @@ int run_slave(const SlaveOptions& o) {
     fmt::print(stderr, "lash hil slave: no CCP CONNECT within {} s on {}\n", format_double(o.connect_timeout), s.bus);
     return kExitFailed;
   }
-  hil::write_slave_csv(o.log, r);
-  hil::write_events(std::filesystem::path(o.log).replace_extension("").string() + ".events.csv", r.events);
   if (!o.stats.empty()) write_text(o.stats, hil::slave_stats_json(r));
-  const auto tet = rt::tet_us(r.loop.records);
+  const auto& tet = r.stats.tet_us;
   const auto& f = r.stats.frames;
   fmt::print(stderr,
              "lash hil slave: {} steps ({}), TET mean {:.2f} us max {:.2f} us (CAN I/O mean {:.2f} us), overruns {}, "
              "commands received {} late {} lost {}; cpu_dma_latency {}\n",
-             r.stats.result.steps, rt::to_string(r.stats.result.reason), tet.mean, tet.max,
-             rt::io_us(r.loop.records).mean, r.stats.result.overruns, f.received, f.late, f.lost,
-             r.stats.dma_latency_held ? "held at 0" : "not held");
+             r.stats.result.steps, rt::to_string(r.stats.result.reason), tet.mean, tet.max, r.stats.io_us.mean,
+             r.stats.result.overruns, f.received, f.late, f.lost, r.stats.dma_latency_held ? "held at 0" : "not held");
+  warn_ring("slave", r.stats.logs);
   return kExitOk;
 }
 
@@ -97,17 +104,19 @@ int run_master(const MasterOptions& o) {
   ro.reference = o.reference;
   ro.dto_timeout_s = o.dto_timeout;
   ro.xcp = o.xcp == "on";
+  ro.logs.csv = o.log;
+  ro.logs.events =
+      o.events.empty() ? (std::filesystem::path(o.log).replace_extension("").string() + ".events.csv") : o.events;
+  ro.logs.bus_log = o.bus_log;
+  if (!o.bus_log.empty() && can::log_format_of(o.bus_log) != can::LogFormat::candump)
+    throw InputError("", 0, "--bus-log", "the bus log is written while the master runs, as candump -L text: give a "
+                                         "name that does not end in .asc, .blf or .trc (got " + o.bus_log + ")");
   (void)hil::parse_reference(o.reference);
   (void)hil::steps_for(o.duration, s.step_s, "--duration");
   hil::install_node_signal_handlers();
   const hil::MasterRun r = hil::run_master_node(s, ro, hil::node_stop_flag());
   warn_all("master", r.loop.warnings);
   if (o.result_fd >= 0) hil::write_run(o.result_fd, r);
-  hil::write_master_csv(o.log, r);
-  if (!o.bus_log.empty()) hil::write_bus_log(o.bus_log, r);
-  hil::write_events(
-      o.events.empty() ? (std::filesystem::path(o.log).replace_extension("").string() + ".events.csv") : o.events,
-      r.events, r.calibration);
   if (!o.stats.empty()) write_text(o.stats, hil::master_stats_json(r, o.reference));
   for (const auto& e : r.events)
     fmt::print(stderr, "lash hil master: t = {:.3f} s (step {}): {}\n", e.t_s, e.step, to_string(e.kind));
@@ -118,8 +127,9 @@ int run_master(const MasterOptions& o) {
                format_double(o.dto_timeout > 0 ? o.dto_timeout : s.dto_timeout_s), s.bus);
     return kExitFailed;
   }
-  const auto tet = rt::tet_us(r.loop.records);
+  const auto& tet = r.stats.tet_us;
   const auto& f = r.stats.frames;
+  warn_ring("master", r.stats.logs);
   fmt::print(stderr,
              "lash hil master: {} steps ({}), handshake {:.4f} s, TET mean {:.2f} us max {:.2f} us, overruns {}, "
              "sensor frames received {} late {} lost {}; cpu_dma_latency {}\n",
@@ -175,7 +185,7 @@ void add_hil_nodes(CLI::App* hil, std::function<int()>& run_selected) {
   add_common(slave, so->common);
   add_scenario(slave, so->common);
   add_controller(slave, so->common);
-  add_duration(slave, so->duration, "Longest run (log buffer size); stops earlier on SIGINT/SIGTERM/SIGHUP");
+  add_duration(slave, so->duration, "Longest run; stops earlier on SIGINT/SIGTERM/SIGHUP");
   slave->add_option("--log", so->log, "Per-step CSV log");
   slave->add_option("--stats", so->stats, "Statistics JSON");
   slave->add_option("--seed", so->seed, "Noise seed (-1 = from the settings)")->check(CLI::Range(std::int64_t{-1}, INT64_MAX));

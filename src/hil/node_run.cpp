@@ -2,6 +2,7 @@
 
 #include <signal.h>
 #include <time.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -26,6 +27,12 @@ namespace lash::hil {
 namespace {
 InputError option_error(const std::string& option, const std::string& message) {
   return InputError("", 0, option, message);
+}
+
+/// Peak resident set of this process [kB] (getrusage ru_maxrss).
+long peak_rss_kB() {
+  rusage u{};
+  return getrusage(RUSAGE_SELF, &u) == 0 ? u.ru_maxrss : -1;
 }
 
 double realtime_now_s() {
@@ -60,7 +67,7 @@ std::size_t steps_for(double duration_s, double step_s, const std::string& optio
   const double n = std::round(duration_s / step_s);
   if (n > static_cast<double>(kMaxSteps))
     throw option_error(option, "too long: " + format_double(n) + " steps of " + format_double(step_s * 1e3) +
-                                   " ms; at most " + std::to_string(kMaxSteps) + " steps (the logs are preallocated)");
+                                   " ms; at most " + std::to_string(kMaxSteps) + " steps");
   return static_cast<std::size_t>(std::max(1.0, n));
 }
 
@@ -158,9 +165,13 @@ SlaveRun run_slave_node(const BenchSettings& s, const SlaveRunOptions& o, const 
   const std::size_t steps = steps_for(o.duration_s, s.step_s, "--duration");
   if (!(o.connect_timeout_s >= 0) || !std::isfinite(o.connect_timeout_s))
     throw option_error("--connect-timeout", "must be >= 0 [s] (0 = wait until stopped)");
-  SlaveNode slave(L, slave_config(s, L, steps));
-  const rt::LoopConfig lc = make_loop_config(o.loop, steps);
+  SlaveNode slave(L, slave_config(s, L, 1));  // one row: handed to the writer after each step
+  rt::LoopConfig lc = make_loop_config(o.loop, steps);
+  lc.keep_records = false;
   rt::PeriodicLoop loop(lc);
+  // The writer thread is started before the real-time settings: it keeps the default
+  // scheduler and every CPU (a thread inherits them from the thread that creates it).
+  NodeLogWriter writer(NodeLogWriter::Node::slave, o.logs, steps);
   SlaveRun out;
   out.loop.warnings = loop.apply_realtime_settings();
   auto bus = open_node_bus(s.bus, L, false);
@@ -178,6 +189,7 @@ SlaveRun run_slave_node(const BenchSettings& s, const SlaveRunOptions& o, const 
   }
   out.stats.period_ns = lc.period_ns;
   out.stats.seed = s.plant.seed;
+  std::size_t events_seen = 0;
   if (out.stats.connected) {
     const std::int64_t t_connect = rt::monotonic_ns();
     // The slave's grid sits half a period after the master's (see nodes.hpp). The loop and its
@@ -186,22 +198,43 @@ SlaveRun run_slave_node(const BenchSettings& s, const SlaveRunOptions& o, const 
     const rt::DmaLatencyHold dma(o.loop.hold_dma_latency);
     out.stats.dma_latency_held = dma.held();
     out.stats.epoch_s = realtime_now_s() - static_cast<double>(rt::monotonic_ns() - (t_connect + lc.period_ns / 2)) * 1e-9;
+    writer.set_epoch(out.stats.epoch_s);
     out.stats.result = loop.run_with_io(
         [&]() noexcept { ctl.pull(); },
         [&](std::size_t, std::int64_t t_ns) noexcept {
           slave.step(ctl, static_cast<double>(t_ns) * 1e-9);
           return true;
         },
-        [&]() noexcept { ctl.flush(); }, stop);
+        [&]() noexcept { ctl.flush(); },
+        // After the timed cycle: hand the step's events and row to the writer (never waits).
+        [&](std::size_t, const rt::StepRecord& rec) noexcept {
+          const auto ev = slave.events();
+          for (; events_seen < ev.size(); ++events_seen) writer.push(ev[events_seen]);
+          if (!slave.log().empty()) writer.push(SlaveRow{slave.log()[0], rec});
+          slave.clear_step_log();
+        },
+        stop);
   }
+  for (const auto ev = slave.events(); events_seen < ev.size(); ++events_seen) writer.push(ev[events_seen]);
+  try {
+    writer.stop();
+  } catch (const std::exception& e) {
+    out.loop.warnings.push_back(e.what());
+  }
+  out.stats.logs = writer.stats();
+  const LoopSummaries sum = writer.loop();
+  out.stats.tet_us = sum.tet_us;
+  out.stats.io_us = sum.io_us;
+  out.stats.cycle_us = sum.cycle_us;
+  out.stats.wake_latency_us = sum.wake_latency_us;
   take_loop(loop, out.loop);
-  out.log.assign(slave.log().begin(), slave.log().end());
   out.events.assign(slave.events().begin(), slave.events().end());
   out.stats.state = slave.state();
   out.stats.frames = frame_stats(slave.commands(), slave.frames_sent(), slave.ignored_frames(), slave.send_failures(),
                                  bus->stats());
   out.stats.controller = ctl.controller_stats();
   out.stats.dto_replies = slave.dto_replies();
+  out.stats.peak_rss_kB = peak_rss_kB();
   return out;
 }
 
@@ -216,12 +249,15 @@ MasterRun run_master_node(const BenchSettings& s, const MasterRunOptions& o, con
     throw option_error("--dto-timeout", "too long: " + format_double(mc.dto_timeout_s) + " s; at most " + std::to_string(kMaxSteps) +
                                             " steps of " + format_double(s.step_s * 1e3) + " ms");
   const std::size_t steps = control_steps + *wait_steps + 2;
-  mc.log_capacity = steps;
+  mc.log_capacity = 1;                 // one row and one step's frames: handed to the writer after each step
+  mc.bus_log_capacity = kStepFrames;
   MasterNode master(L, mc);
-  rt::PeriodicLoop loop(make_loop_config(o.loop, steps));
-  // The XCP slave: its own thread and socket; the step meets it through two lock-free queues.
-  // Started before the loop's real-time settings, so that it keeps the default scheduler and
-  // every CPU (a thread inherits SCHED_FIFO and the affinity of the thread that creates it).
+  rt::LoopConfig lc = make_loop_config(o.loop, steps);
+  lc.keep_records = false;
+  rt::PeriodicLoop loop(lc);
+  // The XCP slave and the log writer: their own threads; the step meets them through lock-free
+  // queues. Started before the loop's real-time settings, so that they keep the default
+  // scheduler and every CPU (a thread inherits SCHED_FIFO and the affinity of its creator).
   std::unique_ptr<XcpLink> link;
   std::unique_ptr<XcpServer> xcp;
   if (o.xcp) {
@@ -229,23 +265,40 @@ MasterRun run_master_node(const BenchSettings& s, const MasterRunOptions& o, con
     xcp = std::make_unique<XcpServer>(s.bus, L, *link, initial_calibration(mc));
     master.attach(link.get());
   }
+  NodeLogWriter writer(NodeLogWriter::Node::master, o.logs, steps);
   MasterRun out;
   out.loop.warnings = loop.apply_realtime_settings();
   auto bus = open_node_bus(s.bus, L, true);
   const auto N = static_cast<std::int64_t>(control_steps);
   can::ControllerBus ctl(*bus, node_controller_config(loop.config().period_ns));
+  std::size_t events_seen = 0, calibration_seen = 0;
   {
     const rt::DmaLatencyHold dma(o.loop.hold_dma_latency);
     out.stats.dma_latency_held = dma.held();
+    // r_0 fixed here, so that the wall-clock epoch of the bus log is known before the first step.
+    const std::int64_t start = rt::monotonic_ns() + loop.config().period_ns;
+    loop.set_start_ns(start);
+    out.stats.epoch_s = realtime_now_s() - static_cast<double>(rt::monotonic_ns() - start) * 1e-9;
+    writer.set_epoch(out.stats.epoch_s);
     out.stats.result = loop.run_with_io(
         [&]() noexcept { ctl.pull(); },
         [&](std::size_t, std::int64_t t_ns) noexcept {
           const bool ok = master.step(ctl, static_cast<double>(t_ns) * 1e-9);
           return ok && master.control_steps() < N;
         },
-        [&]() noexcept { ctl.flush(); }, stop);
+        [&]() noexcept { ctl.flush(); },
+        // After the timed cycle: hand the step's events, frames and row to the writer (never waits).
+        [&](std::size_t, const rt::StepRecord& rec) noexcept {
+          const auto ev = master.events();
+          for (; events_seen < ev.size(); ++events_seen) writer.push(ev[events_seen]);
+          const auto cal = master.calibration_events();
+          for (; calibration_seen < cal.size(); ++calibration_seen) writer.push(cal[calibration_seen]);
+          for (const auto& f : master.bus_log()) writer.push(f);
+          if (!master.log().empty()) writer.push(MasterRow{master.log()[0], rec});
+          master.clear_step_logs();
+        },
+        stop);
   }
-  out.stats.epoch_s = realtime_now_s() - static_cast<double>(rt::monotonic_ns() - loop.start_ns()) * 1e-9;
   out.stats.period_ns = loop.config().period_ns;
   if (xcp) {
     xcp->stop();
@@ -257,11 +310,20 @@ MasterRun run_master_node(const BenchSettings& s, const MasterRunOptions& o, con
     out.stats.xcp_samples_lost = xs.samples_lost;
     out.stats.xcp_pages = xs.pages;
   }
+  try {
+    writer.stop();
+  } catch (const std::exception& e) {
+    out.loop.warnings.push_back(e.what());
+  }
+  out.stats.logs = writer.stats();
+  const LoopSummaries sum = writer.loop();
+  out.stats.tet_us = sum.tet_us;
+  out.stats.io_us = sum.io_us;
+  out.stats.cycle_us = sum.cycle_us;
+  out.stats.wake_latency_us = sum.wake_latency_us;
   out.calibration.assign(master.calibration_events().begin(), master.calibration_events().end());
   take_loop(loop, out.loop);
-  out.log.assign(master.log().begin(), master.log().end());
   out.events.assign(master.events().begin(), master.events().end());
-  out.bus_log.assign(master.bus_log().begin(), master.bus_log().end());
   out.stats.frames = frame_stats(master.sensors(), master.frames_sent(), master.ignored_frames(),
                                  master.send_failures(), bus->stats());
   out.stats.frames.bus_log_dropped = master.bus_log_dropped();
@@ -270,6 +332,7 @@ MasterRun run_master_node(const BenchSettings& s, const MasterRunOptions& o, con
   out.stats.control_steps = master.control_steps();
   out.stats.handshake_s = master.handshake_s();
   out.stats.compensation = master.compensation();
+  out.stats.peak_rss_kB = peak_rss_kB();
   return out;
 }
 
@@ -407,15 +470,19 @@ json loop_json(const NodeStats& st, const LoopTrace& t) {
   json j;
   j["steps"] = st.result.steps;
   j["stop_reason"] = rt::to_string(st.result.reason);
-  j["tet_us"] = summary_json(rt::tet_us(t.records));
-  j["io_us"] = summary_json(rt::io_us(t.records));
-  j["cycle_us"] = summary_json(rt::cycle_us(t.records));
-  j["wake_latency_us"] = summary_json(rt::wake_latency_us(t.records));
+  const bool kept = !t.records.empty();  // else: the writer's statistics over every step
+  j["tet_us"] = summary_json(kept ? rt::tet_us(t.records) : st.tet_us);
+  j["io_us"] = summary_json(kept ? rt::io_us(t.records) : st.io_us);
+  j["cycle_us"] = summary_json(kept ? rt::cycle_us(t.records) : st.cycle_us);
+  j["wake_latency_us"] = summary_json(kept ? rt::wake_latency_us(t.records) : st.wake_latency_us);
   j["overruns"] = st.result.overruns;
   json ov = json::array();
   for (const auto& e : t.overruns)
     ov.push_back({{"step", e.step}, {"t_s", static_cast<double>(e.t_ns) * 1e-9}, {"late_us", us(e.late_ns)}});
-  j["overrun_events"] = ov;
+  j["overrun_events"] = ov;  // the first rt::kMaxOverrunEvents
+  j["logs"] = {{"rows", st.logs.rows}, {"frames", st.logs.frames}, {"events", st.logs.events},
+               {"ring_full", st.logs.ring_full}, {"writes", st.logs.writes}, {"last_t_s", st.logs.last_t_s},
+               {"peak_rss_kB", st.peak_rss_kB}};
   j["warnings"] = t.warnings;
   j["step_s"] = static_cast<double>(st.period_ns) * 1e-9;
   j["dma_latency_held"] = st.dma_latency_held;

@@ -153,6 +153,12 @@ std::vector<std::string> loop_args(const LoopOptions& l, const SessionOptions& o
   return a;
 }
 
+/// The statistics of a node known only from its log (it was killed before its hand-over).
+void recover_stats(NodeStats& st, std::size_t rows, NodeState last_state) {
+  st.result.steps = rows;
+  st.state = last_state;
+}
+
 void close_fd(int& fd) {
   if (fd >= 0) close(fd);
   fd = -1;
@@ -347,13 +353,44 @@ RunReport Session::run(const std::function<void(const std::string&)>& progress) 
       reap_blocking(s, t0, 10.0);
     }
 
-  // Collect the runs in memory.
+  // Collect the runs: the statistics each node handed over (memory file), the logs from the
+  // files its log writer streamed while it ran. A node killed before it could hand over
+  // (kill -9) is recovered from what its writer had put on disk (at most the last second lost).
   MasterRun mrun;
-  const bool have_master = read_run(master.result_fd, mrun);
+  bool have_master = read_run(master.result_fd, mrun);
+  const auto master_csv = dir / "master.csv";
+  if (std::filesystem::exists(master_csv)) {
+    const LogReadBack rb = read_master_log(master_csv, mrun.log, mrun.loop.records);
+    if (!have_master && rb.rows > 0) {
+      have_master = true;
+      recover_stats(mrun.stats, rb.rows, mrun.log.empty() ? NodeState::startup : mrun.log.back().state);
+      std::int64_t last_m = -1;
+      for (const auto& l : mrun.log) last_m = std::max(last_m, l.control_step);
+      mrun.stats.control_steps = last_m + 1;
+      mrun.stats.period_ns = static_cast<std::int64_t>(std::llround(o_.settings.step_s * 1e9));
+      rep.master_recovered = LogRecovery{master_csv.string(), rb.rows, rb.cut_lines, rb.last_t_s};
+      say("the master handed nothing over (status " + std::to_string(master.exit.status) + "): recovered " +
+          std::to_string(rb.rows) + " rows up to t = " + format_double(rb.last_t_s) + " s from " + master_csv.string());
+    }
+  }
   std::vector<SlaveRun> sruns;
-  for (auto& s : slaves) {
+  for (std::size_t i = 0; i < slaves.size(); ++i) {
+    Child& s = slaves[i];
     SlaveRun r;
-    if (!read_run(s.result_fd, r)) r = SlaveRun{};  // killed before it could hand over: no log
+    const bool handed = read_run(s.result_fd, r);
+    if (!handed) r = SlaveRun{};
+    const auto csv = dir / (i == 0 ? std::string("slave.csv") : "slave." + std::to_string(i + 1) + ".csv");
+    if (std::filesystem::exists(csv)) {
+      const LogReadBack rb = read_slave_log(csv, r.log, r.loop.records);
+      if (!handed && rb.rows > 0) {
+        recover_stats(r.stats, rb.rows, r.log.back().state);
+        r.stats.connected = true;
+        if (i == 0) rep.slave_recovered = LogRecovery{csv.string(), rb.rows, rb.cut_lines, rb.last_t_s};
+        say("slave " + std::to_string(i + 1) + " handed nothing over (status " + std::to_string(s.exit.status) +
+            "): recovered " + std::to_string(rb.rows) + " rows up to t = " + format_double(rb.last_t_s) + " s from " +
+            csv.string());
+      }
+    }
     sruns.push_back(std::move(r));
     rep.slave_exits.push_back(s.exit);
     cleanup(s);
@@ -377,7 +414,13 @@ RunReport Session::run(const std::function<void(const std::string&)>& progress) 
       rep.observed_schedule_note = "not replayed: the schedule of one slave from start to end is needed";
     } else {
       try {
-        const FrameSchedule fs = observed_schedule(mrun.log, sruns[0].log);
+        FrameSchedule fs = observed_schedule(mrun.log, sruns[0].log);
+        const std::size_t kept = replayable_control_steps(fs);
+        if (kept < fs.master.size()) {  // a killed slave's log ends before the master's
+          fs.master.resize(kept);
+          rep.observed_schedule_note = "replayed the first " + std::to_string(kept) +
+                                       " control steps: the slave's log ends before the master's";
+        }
         rep.vs_observed_schedule = compare_with_simulation(mrun.log, simulate_bench(L, mc, sc, fs).master);
       } catch (const std::invalid_argument& e) {
         rep.observed_schedule_note = std::string("not replayed: ") + e.what();

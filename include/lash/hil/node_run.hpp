@@ -16,6 +16,7 @@
 
 #include "lash/can/controller_bus.hpp"
 #include "lash/hil/e2e.hpp"
+#include "lash/hil/log_writer.hpp"
 #include "lash/hil/nodes.hpp"
 #include "lash/hil/settings.hpp"
 #include "lash/rt/periodic.hpp"
@@ -25,7 +26,8 @@ namespace lash::hil {
 /// Limits of the real-time options (documented in `--help`).
 inline constexpr double kMinStepMs = 0.1;     ///< shortest step the loop is let run [ms] (see docs/hil.md)
 inline constexpr double kMaxStepMs = 1000.0;  ///< longest step [ms]
-/// Most steps one run may record: 2e7 steps × (32 B loop record + < 64 B node log) < 2 GB.
+/// Most steps one run may take (a node streams its logs: its memory does not depend on it; the
+/// percentile tails of its statistics hold steps/100 values, 0.6 MB at this limit).
 inline constexpr std::size_t kMaxSteps = 20'000'000;
 
 /// Real-time options shared by the nodes and `lash hil latency`.
@@ -80,6 +82,11 @@ struct NodeStats {
   FrameStats frames;
   can::ControllerStats controller;
   bool dma_latency_held = false; ///< /dev/cpu_dma_latency was held at 0 during the loop
+  /// Loop statistics over every step [µs] (the log writer's, log_writer.hpp: the records are
+  /// not kept in memory).
+  rt::Summary tet_us, io_us, cycle_us, wake_latency_us;
+  LogStats logs;                 ///< what the log writer wrote, and the items a full ring refused
+  long peak_rss_kB = -1;         ///< the node process's peak resident set at the end of its run [kB] (getrusage)
   NodeState state = NodeState::startup;  ///< the safe-state machine's state at the end (nodes.hpp)
   // master only
   std::int64_t control_steps = 0;
@@ -118,12 +125,14 @@ struct MasterRun {
 
 struct SlaveRunOptions {
   LoopOptions loop;
+  LogPaths logs;                    ///< slave.csv, slave.events.csv (streamed while the node runs)
   double duration_s = 600.0;        ///< longest run (log size) [s]
   double connect_timeout_s = 0.0;   ///< 0 = wait for CONNECT until stopped
 };
 
 struct MasterRunOptions {
   LoopOptions loop;
+  LogPaths logs;                    ///< master.csv, master.events.csv, master_bus.log (streamed)
   double duration_s = 10.0;         ///< control time after the handshake [s]
   std::string reference = "step:from=500,to=1500,time=1";
   double dto_timeout_s = 0.0;       ///< 0 = from the settings
@@ -132,6 +141,9 @@ struct MasterRunOptions {
 
 /// Runs the slave: waits for a CCP CONNECT (polling `stop`), then steps until `stop`, the
 /// duration or an overrun stop. `on_ready(address)` is called once the bus is open.
+/// Both runs stream their logs to o.logs while they run (log_writer.hpp): the returned run's
+/// `log` (and the master's `bus_log`) are empty, its loop records too; the statistics are in
+/// `stats`. A node killed outright leaves its logs on disk up to the last flush.
 SlaveRun run_slave_node(const BenchSettings& s, const SlaveRunOptions& o, const std::atomic<bool>& stop,
                         const std::function<void(const std::string&)>& on_ready = {});
 /// Runs the master: CONNECT, then `duration_s` of control (or until `stop`).
@@ -158,6 +170,19 @@ void write_bus_log(const std::filesystem::path& path, const MasterRun& r);
 /// The statistics JSON of `lash hil slave/master --stats`.
 std::string slave_stats_json(const SlaveRun& r);
 std::string master_stats_json(const MasterRun& r, const std::string& reference);
+
+/// A node's CSV log read back (a killed node's included): the rows and their loop records.
+/// A last line cut short is dropped (cut_lines); a value that is not a number is an InputError
+/// naming file, line and column. Not real-time code.
+struct LogReadBack {
+  std::size_t rows = 0;
+  std::size_t cut_lines = 0;   ///< an unfinished last line (the node was killed mid-write)
+  double last_t_s = -1.0;      ///< t_s of the last row [s]; −1: no row
+};
+LogReadBack read_master_log(const std::filesystem::path& path, std::vector<MasterStepLog>& log,
+                            std::vector<rt::StepRecord>& records);
+LogReadBack read_slave_log(const std::filesystem::path& path, std::vector<SlaveStepLog>& log,
+                           std::vector<rt::StepRecord>& records);
 
 /// Binary hand-over of a run from a node process to its session (same executable on both
 /// sides): write at the end of the run to an inherited descriptor, read back after it exited.
