@@ -9,6 +9,9 @@
 
 #include "cmd_hil.hpp"
 #include "lash/can/log.hpp"
+#include "lash/hil/handover.hpp"
+#include "lash/hil/launch.hpp"
+#include "lash/hil/node_report.hpp"
 #include "lash/rt/dma_latency.hpp"
 
 namespace lash::cli::hilcli {
@@ -138,12 +141,61 @@ int run_master(const MasterOptions& o) {
   return kExitOk;
 }
 
+/// A node started by `lash hil run` from its launch file (hil/launch.hpp): the launch's fields
+/// become the options of `lash hil slave` / `lash hil master`.
+int run_node(const std::string& launch_file) {
+  const hil::NodeLaunch l = hil::read_launch(launch_file);
+  CommonOptions c;
+  c.config = l.config.string();
+  c.bus = l.bus;
+  c.step_ms = l.step_s * 1e3;
+  c.fifo = l.loop.fifo;
+  c.cpu = l.loop.cpu;
+  c.spin_us = l.loop.spin_us;
+  c.lock_memory = l.loop.lock_memory;
+  c.no_dma_latency = !l.loop.hold_dma_latency;
+  c.overrun_policy = l.loop.policy == rt::OverrunPolicy::stop ? "stop" : "tolerate";
+  c.max_overruns = l.loop.max_overruns;
+  c.scenario = l.scenario.string();
+  if (!c.scenario.empty()) {
+    c.compensation = l.compensation;
+    c.compensation_given = true;
+  }
+  c.controller = controller_overrides_from_keys(l.controller, launch_file);
+  if (l.role == hil::NodeLaunch::Role::slave) {
+    SlaveOptions o;
+    o.common = c;
+    o.duration = l.duration_s;
+    o.log = l.logs.csv.string();
+    o.stats = l.stats.string();
+    o.seed = l.seed;
+    o.connect_timeout = l.connect_timeout_s;
+    o.result_fd = l.result_fd;
+    return run_slave(o);
+  }
+  MasterOptions o;
+  o.common = c;
+  o.duration = l.duration_s;
+  o.reference = l.reference;
+  o.log = l.logs.csv.string();
+  o.bus_log = l.logs.bus_log.string();
+  o.events = l.logs.events.string();
+  o.stats = l.stats.string();
+  o.dto_timeout = l.dto_timeout_s;
+  o.xcp = l.xcp ? "on" : "off";
+  o.result_fd = l.result_fd;
+  return run_master(o);
+}
+
 /// The periodic loop alone, no bus and no task (like cyclictest).
 int run_latency(const LatencyOptions& o) {
   const hil::BenchSettings s = load_settings(o.common);
   const hil::LoopOptions lo = loop_options(o.common, s);
   const std::size_t steps = hil::steps_for(o.duration, s.step_s, "--duration");
-  rt::PeriodicLoop loop(hil::make_loop_config(lo, steps));
+  rt::LoopConfig lc = hil::make_loop_config(lo, steps);
+  lc.keep_records = false;  // statistics over a stream: memory independent of --duration
+  rt::PeriodicLoop loop(lc);
+  rt::StreamSummary wake(steps);
   hil::install_node_signal_handlers();
   const auto warnings = loop.apply_realtime_settings();
   warn_all("latency", warnings);
@@ -152,9 +204,13 @@ int run_latency(const LatencyOptions& o) {
   {
     const rt::DmaLatencyHold dma(lo.hold_dma_latency);
     held = dma.held();
-    r = loop.run([](std::size_t, std::int64_t) noexcept { return true; }, hil::node_stop_flag());
+    r = loop.run_with_io([]() noexcept {}, [](std::size_t, std::int64_t) noexcept { return true; }, []() noexcept {},
+                         [&](std::size_t, const rt::StepRecord& rec) noexcept {
+                           wake.add(static_cast<double>(rec.wake_latency_ns) * 1e-3);
+                         },
+                         hil::node_stop_flag());
   }
-  const auto w = loop.wake_latency_us();
+  const auto w = wake.result();
   if (o.json_out) {
     nlohmann::json j{{"steps", r.steps},
                      {"stop_reason", rt::to_string(r.reason)},
@@ -218,7 +274,13 @@ void add_hil_nodes(CLI::App* hil, std::function<int()>& run_selected) {
   add_duration(lat, lo->duration, "Measurement time");
   lat->add_flag("--json", lo->json_out, "Print the statistics as one JSON object");
 
+  auto launch = std::make_shared<std::string>();
+  auto* node = hil->add_subcommand("node", "A node of `lash hil run`, from its launch file");
+  node->group("");  // hidden: started by `lash hil run` (hil/launch.hpp)
+  node->add_option("launch", *launch, "Launch file (JSON) written by `lash hil run`")->required();
+
   run_selected = [=]() -> int {
+    if (node->parsed()) return run_node(*launch);
     if (slave->parsed()) return run_slave(*so);
     if (master->parsed()) return run_master(*mo);
     if (lat->parsed()) return run_latency(*lo);

@@ -138,9 +138,11 @@ int run_run(const RunOptions& o) {
   so.duration_s = o.duration;
   if (so.settings.scenario) {  // the scenario's duration unless --duration is given
     if (!o.duration_given) so.duration_s = so.settings.scenario->duration_s;
-    so.node_args = {"--scenario", o.common.scenario, "--compensation", o.common.compensation};
+    so.scenario = o.common.scenario;
+    so.compensation = o.common.compensation;
   }
-  for (auto& a : controller_option_args(o.common.controller)) so.node_args.push_back(std::move(a));
+  so.controller = controller_override_keys(o.common.controller);
+  so.node_command = {"/proc/self/exe", "hil", "node"};  // `lash hil node LAUNCH.json` (cmd_hil_nodes.cpp)
   so.reference = o.reference;
   so.out_dir = o.out_dir;
   so.isolate = !o.no_isolate;

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "lash/hil/node_run.hpp"
+#include "lash/hil/handover.hpp"
 #include "lash/io/error.hpp"
 
 namespace lash::hil {

@@ -68,9 +68,9 @@ Summary summarize(std::span<const double> values) {
   return s;
 }
 
-StreamSummary::StreamSummary(std::size_t max_n) : tail_cap_(max_n / 100 + 2) {}
+StreamSummary::StreamSummary(std::size_t max_n) : tail_cap_(max_n / 100 + 2) { tail_.reserve(tail_cap_); }
 
-void StreamSummary::add(double v) {
+void StreamSummary::add(double v) noexcept {
   if (n_ == 0) {
     min_ = max_ = v;
   } else {

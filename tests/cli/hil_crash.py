@@ -47,7 +47,7 @@ def node_pid(parent, role, timeout=10):
     end = time.time() + timeout
     while time.time() < end:
         for pid, argv in children(parent).items():
-            if len(argv) > 2 and argv[1] == "hil" and argv[2] == role:
+            if hil_netns.node_role(argv) == role:
                 return pid
         time.sleep(0.02)
     raise AssertionError(f"no {role} node under pid {parent}: {children(parent)}")

@@ -2,9 +2,12 @@
 /// @file node_run.hpp
 /// One node of the bench as a process runs it (`lash hil slave`, `lash hil master`, and the
 /// children of `lash hil run`): settings → node → emulated CAN controller on a bus → the
-/// periodic loop, and what a run leaves behind (logs, loop records, counters) in memory.
-/// The option checks live here too, so that every face of the library refuses the same
-/// values with the same message before any work. Not real-time code, except the loops it runs.
+/// periodic loop, its logs streamed to disk (log_writer.hpp), and what a run ends with
+/// (statistics, counters, events). The option checks live here too, so that every face of the
+/// library refuses the same values with the same message (naming the options' fields) before
+/// any work. Its neighbours by concern: handover.hpp (a run from the node process to its
+/// session), node_report.hpp (a run's files and statistics JSON), launch.hpp (a node's
+/// configuration as data, how a session starts it). Not real-time code, except the loops it runs.
 #include <array>
 #include <atomic>
 #include <cstddef>
@@ -40,15 +43,16 @@ struct LoopOptions {
   rt::OverrunPolicy policy = rt::OverrunPolicy::tolerate;
   std::size_t max_overruns = 10;               ///< policy stop: consecutive overruns before stopping
   bool hold_dma_latency = true;                ///< hold /dev/cpu_dma_latency at 0 µs while the loop runs
-  /// Throws InputError naming the option (`--fifo`, `--step-ms`, …) for a value out of its range.
+  /// Throws InputError naming the field (`loop.fifo`, `loop.step_s`, …) for a value out of its
+  /// range (a face maps the field to its option in its message).
   void validate() const;
 };
 
-/// Parses `tolerate` / `stop`; throws InputError(field `--overrun-policy`) otherwise.
+/// Parses `tolerate` / `stop`; throws InputError(field `loop.policy`) otherwise.
 rt::OverrunPolicy parse_overrun_policy(const std::string& text);
-/// Steps of a run of `duration_s` at `step_s`: ≥ 1, and refused (InputError naming `option`)
+/// Steps of a run of `duration_s` at `step_s`: ≥ 1, and refused (InputError naming `field`)
 /// when not finite, ≤ 0 or above kMaxSteps.
-std::size_t steps_for(double duration_s, double step_s, const std::string& option);
+std::size_t steps_for(double duration_s, double step_s, const std::string& field);
 /// The loop configuration of `steps` steps (options validated first).
 rt::LoopConfig make_loop_config(const LoopOptions& o, std::size_t steps);
 
@@ -154,42 +158,8 @@ MasterRun run_master_node(const BenchSettings& s, const MasterRunOptions& o, con
 const std::atomic<bool>& node_stop_flag() noexcept;
 void install_node_signal_handlers();
 
-/// Log files of a run (atomic writes; columns documented in docs/hil.md).
-void write_slave_csv(const std::filesystem::path& path, const SlaveRun& r);
-void write_master_csv(const std::filesystem::path& path, const MasterRun& r);
-/// A node's events CSV: `step,t_s,event,from,to`.
-void write_events(const std::filesystem::path& path, const std::vector<NodeEvent>& events);
-/// The master's events CSV: `step,t_s,event,from,to,name,old,new`, the state events and the
-/// calibration writes (event `calibration`, the object's name, its old and new value) in step order.
-void write_events(const std::filesystem::path& path, const std::vector<NodeEvent>& events,
-                  const std::vector<CalibrationEvent>& calibration);
-/// candump -L log of the frames the master sent and received, in wall-clock seconds: a sent
-/// frame carries its loop time (added to the loop's epoch), a received one the bus's receive
-/// timestamp, which is wall-clock already.
-void write_bus_log(const std::filesystem::path& path, const MasterRun& r);
-/// The statistics JSON of `lash hil slave/master --stats`.
-std::string slave_stats_json(const SlaveRun& r);
-std::string master_stats_json(const MasterRun& r, const std::string& reference);
-
-/// A node's CSV log read back (a killed node's included): the rows and their loop records.
-/// A last line cut short is dropped (cut_lines); a value that is not a number is an InputError
-/// naming file, line and column. Not real-time code.
-struct LogReadBack {
-  std::size_t rows = 0;
-  std::size_t cut_lines = 0;   ///< an unfinished last line (the node was killed mid-write)
-  double last_t_s = -1.0;      ///< t_s of the last row [s]; −1: no row
-};
-LogReadBack read_master_log(const std::filesystem::path& path, std::vector<MasterStepLog>& log,
-                            std::vector<rt::StepRecord>& records);
-LogReadBack read_slave_log(const std::filesystem::path& path, std::vector<SlaveStepLog>& log,
-                           std::vector<rt::StepRecord>& records);
-
-/// Binary hand-over of a run from a node process to its session (same executable on both
-/// sides): write at the end of the run to an inherited descriptor, read back after it exited.
-/// read_* returns false when the node wrote nothing (it was killed) or the data are cut short.
-void write_run(int fd, const SlaveRun& r);
-void write_run(int fd, const MasterRun& r);
-bool read_run(int fd, SlaveRun& r);
-bool read_run(int fd, MasterRun& r);
-
 }  // namespace lash::hil
+
+// The hand-over of a run (write_run / read_run, the logs read back) lived in this header before
+// it was split by concern; it is included for the code that still finds it here.
+#include "lash/hil/handover.hpp"  // IWYU pragma: export

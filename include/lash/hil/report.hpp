@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "lash/metrics/step_response.hpp"
+#include "lash/hil/handover.hpp"
 #include "lash/hil/node_run.hpp"
 #include "lash/hil/nodes.hpp"
 #include "lash/hil/settings.hpp"

@@ -85,12 +85,12 @@ Summary summarize(std::span<const double> values);
 /// (mean equal bit for bit to summarize()'s, same order of additions), Welford's running
 /// variance (std equal to summarize()'s up to rounding), min, max, and the ⌈max_n/100⌉ + 2
 /// largest values seen, which hold the nearest-rank 99th percentile of any n ≤ max_n values
-/// exactly (n − ⌈0.99·n⌉ + 1 ≤ ⌊n/100⌋ + 1 of them lie at or above it). Not real-time safe
-/// (add() may allocate while the tail fills): for a writer thread, not a step.
+/// exactly (n − ⌈0.99·n⌉ + 1 ≤ ⌊n/100⌋ + 1 of them lie at or above it). The tail is reserved
+/// at construction: add() is noexcept-safe, allocation-free and O(log(max_n/100)).
 class StreamSummary {
  public:
   explicit StreamSummary(std::size_t max_n = 0);
-  void add(double v);
+  void add(double v) noexcept;
   Summary result() const;
   std::size_t count() const noexcept { return n_; }
 
