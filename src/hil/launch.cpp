@@ -110,7 +110,12 @@ NodeLaunch read_launch(const std::filesystem::path& path) {
   l.loop.cpu = f.get<int>(lo, "cpu", "loop.");
   l.loop.spin_us = f.get<double>(lo, "spin_us", "loop.");
   l.loop.lock_memory = f.get<bool>(lo, "lock_memory", "loop.");
-  l.loop.policy = parse_overrun_policy(f.get<std::string>(lo, "policy", "loop."));
+  try {
+    l.loop.policy = parse_overrun_policy(f.get<std::string>(lo, "policy", "loop."));
+  } catch (const InputError& e) {
+    if (!e.file().empty()) throw;
+    throw InputError(path.string(), 0, e.field(), e.message());
+  }
   l.loop.max_overruns = f.get<std::size_t>(lo, "max_overruns", "loop.");
   l.loop.hold_dma_latency = f.get<bool>(lo, "hold_dma_latency", "loop.");
   l.duration_s = f.get<double>(j, "duration_s");
