@@ -89,7 +89,7 @@ void NodeLogWriter::run() noexcept {
     } catch (const std::exception& e) {  // formatting ran out of memory: stop writing, say so
       if (error_.empty()) error_ = e.what();
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    std::this_thread::sleep_for(kLogPollPeriod);
   }
 }
 

@@ -44,9 +44,13 @@ struct SlaveRow {
 /// What a step hands to its writer.
 using LogItem = std::variant<MasterRow, SlaveRow, LoggedFrame, NodeEvent, CalibrationEvent>;
 
-/// Items the ring holds (≈ 2 MB): 3 items a step at most steps of 0.1 ms is 30 000 items/s; the
-/// writer drains the ring every 10 ms.
+/// Items the ring holds (≈ 2 MB): 3 items a step at the shortest step of 0.1 ms is 30 000 items/s;
+/// the writer drains the ring every kLogPollPeriod (1500 items then), so the ring holds 0.27 s of
+/// the fastest run before a stalled writer loses items.
 inline constexpr std::size_t kLogRing = 8192;
+/// How often the writer thread wakes to drain the ring: rarely, so that it seldom runs (and
+/// pollutes the caches) between two of the node's steps.
+inline constexpr std::chrono::milliseconds kLogPollPeriod{50};
 /// Longest time between two writes of a file's pending lines (≤ 1 s, as docs/hil.md promises).
 inline constexpr std::chrono::milliseconds kLogFlushPeriod{200};
 
