@@ -54,8 +54,8 @@ CLI::Option* add_duration(CLI::App* sub, double& value, const std::string& what)
   const double max_s = static_cast<double>(hil::kMaxSteps) * 5e-3;
   return sub
       ->add_option("--duration", value,
-                   what + " [s], > 0; at most " + std::to_string(hil::kMaxSteps) +
-                       " steps (logs are preallocated: " + format_double(max_s) + " s at 5 ms)")
+                   what + " [s], > 0; at most " + std::to_string(hil::kMaxSteps) + " steps (" +
+                       format_double(max_s) + " s at 5 ms; the logs are streamed to disk)")
       ->check(CLI::PositiveNumber);
 }
 
@@ -105,6 +105,22 @@ hil::LoopOptions loop_options(const CommonOptions& o, const hil::BenchSettings& 
   return l;
 }
 
+InputError with_option_names(const InputError& e) {
+  // The library names the fields of its structs (LoopOptions, NodeLaunch, SessionOptions);
+  // a person typed these options.
+  static const std::pair<const char*, const char*> kFlags[] = {
+      {"loop.step_s", "--step-ms"},         {"loop.fifo", "--fifo"},
+      {"loop.cpu", "--cpu"},                {"loop.spin_us", "--spin-us"},
+      {"loop.max_overruns", "--max-overruns"}, {"loop.policy", "--overrun-policy"},
+      {"duration_s", "--duration"},         {"connect_timeout_s", "--connect-timeout"},
+      {"dto_timeout_s", "--dto-timeout"},   {"reference", "--reference"},
+      {"slave_cpu", "--slave-cpu"},         {"out_dir", "--out-dir"},
+      {"isolate", "--no-isolate"}};
+  for (const auto& [field, flag] : kFlags)
+    if (e.field() == field) return InputError(e.file(), e.line(), flag, e.message());
+  return e;
+}
+
 }  // namespace lash::cli::hilcli
 
 namespace lash::cli {
@@ -119,9 +135,13 @@ Command add_hil(CLI::App& app) {
   hilcli::add_hil_run(hil, *run);
   hilcli::add_hil_a2l(hil, *a2l);
   return {hil, [=] {
-            int rc = (*nodes)();
-            if (rc < 0) rc = (*run)();
-            return rc >= 0 ? rc : (*a2l)();
+            try {
+              int rc = (*nodes)();
+              if (rc < 0) rc = (*run)();
+              return rc >= 0 ? rc : (*a2l)();
+            } catch (const InputError& e) {
+              throw hilcli::with_option_names(e);
+            }
           }};
 }
 

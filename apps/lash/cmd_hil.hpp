@@ -3,6 +3,7 @@
 #include <string>
 
 #include "cli_common.hpp"
+#include "lash/io/error.hpp"
 #include "controller_options.hpp"
 #include "lash/hil/node_run.hpp"
 #include "lash/hil/settings.hpp"
@@ -42,6 +43,9 @@ std::string settings_path(const CommonOptions& o);
 
 /// --duration: positive, and at most kMaxSteps steps of the shortest step.
 CLI::Option* add_duration(CLI::App* sub, double& value, const std::string& what);
+
+/// `e` with the library's field name (`loop.step_s`) replaced by the option (`--step-ms`).
+InputError with_option_names(const InputError& e);
 
 void add_hil_nodes(CLI::App* hil, std::function<int()>& run_selected);
 void add_hil_run(CLI::App* hil, std::function<int()>& run_selected);

@@ -8,6 +8,10 @@
 #include <nlohmann/json.hpp>
 
 #include "cmd_hil.hpp"
+#include "lash/can/log.hpp"
+#include "lash/hil/handover.hpp"
+#include "lash/hil/launch.hpp"
+#include "lash/hil/node_report.hpp"
 #include "lash/rt/dma_latency.hpp"
 
 namespace lash::cli::hilcli {
@@ -52,6 +56,12 @@ void warn_all(const char* who, const std::vector<std::string>& warnings) {
   for (const auto& w : warnings) fmt::print(stderr, "lash hil {}: warning: {}\n", who, w);
 }
 
+void warn_ring(const char* who, const hil::LogStats& l) {
+  if (l.ring_full > 0)
+    fmt::print(stderr, "lash hil {}: warning: the log writer fell behind: {} log items were not written (ring full)\n",
+               who, l.ring_full);
+}
+
 int run_slave(const SlaveOptions& o) {
   hil::BenchSettings s = load_settings(o.common);
   if (o.seed >= 0) s.plant.seed = static_cast<std::uint64_t>(o.seed);
@@ -59,6 +69,8 @@ int run_slave(const SlaveOptions& o) {
   ro.loop = loop_options(o.common, s);
   ro.duration_s = o.duration;
   ro.connect_timeout_s = o.connect_timeout;
+  ro.logs.csv = o.log;
+  ro.logs.events = std::filesystem::path(o.log).replace_extension("").string() + ".events.csv";
   (void)hil::steps_for(o.duration, s.step_s, "--duration");
   hil::install_node_signal_handlers();
   const hil::SlaveRun r = hil::run_slave_node(s, ro, hil::node_stop_flag(), [&](const std::string& address) {
@@ -75,17 +87,15 @@ int run_slave(const SlaveOptions& o) {
     fmt::print(stderr, "lash hil slave: no CCP CONNECT within {} s on {}\n", format_double(o.connect_timeout), s.bus);
     return kExitFailed;
   }
-  hil::write_slave_csv(o.log, r);
-  hil::write_events(std::filesystem::path(o.log).replace_extension("").string() + ".events.csv", r.events);
   if (!o.stats.empty()) write_text(o.stats, hil::slave_stats_json(r));
-  const auto tet = rt::tet_us(r.loop.records);
+  const auto& tet = r.stats.tet_us;
   const auto& f = r.stats.frames;
   fmt::print(stderr,
              "lash hil slave: {} steps ({}), TET mean {:.2f} us max {:.2f} us (CAN I/O mean {:.2f} us), overruns {}, "
              "commands received {} late {} lost {}; cpu_dma_latency {}\n",
-             r.stats.result.steps, rt::to_string(r.stats.result.reason), tet.mean, tet.max,
-             rt::io_us(r.loop.records).mean, r.stats.result.overruns, f.received, f.late, f.lost,
-             r.stats.dma_latency_held ? "held at 0" : "not held");
+             r.stats.result.steps, rt::to_string(r.stats.result.reason), tet.mean, tet.max, r.stats.io_us.mean,
+             r.stats.result.overruns, f.received, f.late, f.lost, r.stats.dma_latency_held ? "held at 0" : "not held");
+  warn_ring("slave", r.stats.logs);
   return kExitOk;
 }
 
@@ -97,17 +107,19 @@ int run_master(const MasterOptions& o) {
   ro.reference = o.reference;
   ro.dto_timeout_s = o.dto_timeout;
   ro.xcp = o.xcp == "on";
+  ro.logs.csv = o.log;
+  ro.logs.events =
+      o.events.empty() ? (std::filesystem::path(o.log).replace_extension("").string() + ".events.csv") : o.events;
+  ro.logs.bus_log = o.bus_log;
+  if (!o.bus_log.empty() && can::log_format_of(o.bus_log) != can::LogFormat::candump)
+    throw InputError("", 0, "--bus-log", "the bus log is written while the master runs, as candump -L text: give a "
+                                         "name that does not end in .asc, .blf or .trc (got " + o.bus_log + ")");
   (void)hil::parse_reference(o.reference);
   (void)hil::steps_for(o.duration, s.step_s, "--duration");
   hil::install_node_signal_handlers();
   const hil::MasterRun r = hil::run_master_node(s, ro, hil::node_stop_flag());
   warn_all("master", r.loop.warnings);
   if (o.result_fd >= 0) hil::write_run(o.result_fd, r);
-  hil::write_master_csv(o.log, r);
-  if (!o.bus_log.empty()) hil::write_bus_log(o.bus_log, r);
-  hil::write_events(
-      o.events.empty() ? (std::filesystem::path(o.log).replace_extension("").string() + ".events.csv") : o.events,
-      r.events, r.calibration);
   if (!o.stats.empty()) write_text(o.stats, hil::master_stats_json(r, o.reference));
   for (const auto& e : r.events)
     fmt::print(stderr, "lash hil master: t = {:.3f} s (step {}): {}\n", e.t_s, e.step, to_string(e.kind));
@@ -118,8 +130,9 @@ int run_master(const MasterOptions& o) {
                format_double(o.dto_timeout > 0 ? o.dto_timeout : s.dto_timeout_s), s.bus);
     return kExitFailed;
   }
-  const auto tet = rt::tet_us(r.loop.records);
+  const auto& tet = r.stats.tet_us;
   const auto& f = r.stats.frames;
+  warn_ring("master", r.stats.logs);
   fmt::print(stderr,
              "lash hil master: {} steps ({}), handshake {:.4f} s, TET mean {:.2f} us max {:.2f} us, overruns {}, "
              "sensor frames received {} late {} lost {}; cpu_dma_latency {}\n",
@@ -128,12 +141,61 @@ int run_master(const MasterOptions& o) {
   return kExitOk;
 }
 
+/// A node started by `lash hil run` from its launch file (hil/launch.hpp): the launch's fields
+/// become the options of `lash hil slave` / `lash hil master`.
+int run_node(const std::string& launch_file) {
+  const hil::NodeLaunch l = hil::read_launch(launch_file);
+  CommonOptions c;
+  c.config = l.config.string();
+  c.bus = l.bus;
+  c.step_ms = l.step_s * 1e3;
+  c.fifo = l.loop.fifo;
+  c.cpu = l.loop.cpu;
+  c.spin_us = l.loop.spin_us;
+  c.lock_memory = l.loop.lock_memory;
+  c.no_dma_latency = !l.loop.hold_dma_latency;
+  c.overrun_policy = l.loop.policy == rt::OverrunPolicy::stop ? "stop" : "tolerate";
+  c.max_overruns = l.loop.max_overruns;
+  c.scenario = l.scenario.string();
+  if (!c.scenario.empty()) {
+    c.compensation = l.compensation;
+    c.compensation_given = true;
+  }
+  c.controller = controller_overrides_from_keys(l.controller, launch_file);
+  if (l.role == hil::NodeLaunch::Role::slave) {
+    SlaveOptions o;
+    o.common = c;
+    o.duration = l.duration_s;
+    o.log = l.logs.csv.string();
+    o.stats = l.stats.string();
+    o.seed = l.seed;
+    o.connect_timeout = l.connect_timeout_s;
+    o.result_fd = l.result_fd;
+    return run_slave(o);
+  }
+  MasterOptions o;
+  o.common = c;
+  o.duration = l.duration_s;
+  o.reference = l.reference;
+  o.log = l.logs.csv.string();
+  o.bus_log = l.logs.bus_log.string();
+  o.events = l.logs.events.string();
+  o.stats = l.stats.string();
+  o.dto_timeout = l.dto_timeout_s;
+  o.xcp = l.xcp ? "on" : "off";
+  o.result_fd = l.result_fd;
+  return run_master(o);
+}
+
 /// The periodic loop alone, no bus and no task (like cyclictest).
 int run_latency(const LatencyOptions& o) {
   const hil::BenchSettings s = load_settings(o.common);
   const hil::LoopOptions lo = loop_options(o.common, s);
   const std::size_t steps = hil::steps_for(o.duration, s.step_s, "--duration");
-  rt::PeriodicLoop loop(hil::make_loop_config(lo, steps));
+  rt::LoopConfig lc = hil::make_loop_config(lo, steps);
+  lc.keep_records = false;  // statistics over a stream: memory independent of --duration
+  rt::PeriodicLoop loop(lc);
+  rt::StreamSummary wake(steps);
   hil::install_node_signal_handlers();
   const auto warnings = loop.apply_realtime_settings();
   warn_all("latency", warnings);
@@ -142,9 +204,13 @@ int run_latency(const LatencyOptions& o) {
   {
     const rt::DmaLatencyHold dma(lo.hold_dma_latency);
     held = dma.held();
-    r = loop.run([](std::size_t, std::int64_t) noexcept { return true; }, hil::node_stop_flag());
+    r = loop.run_with_io([]() noexcept {}, [](std::size_t, std::int64_t) noexcept { return true; }, []() noexcept {},
+                         [&](std::size_t, const rt::StepRecord& rec) noexcept {
+                           wake.add(static_cast<double>(rec.wake_latency_ns) * 1e-3);
+                         },
+                         hil::node_stop_flag());
   }
-  const auto w = loop.wake_latency_us();
+  const auto w = wake.result();
   if (o.json_out) {
     nlohmann::json j{{"steps", r.steps},
                      {"stop_reason", rt::to_string(r.reason)},
@@ -175,7 +241,7 @@ void add_hil_nodes(CLI::App* hil, std::function<int()>& run_selected) {
   add_common(slave, so->common);
   add_scenario(slave, so->common);
   add_controller(slave, so->common);
-  add_duration(slave, so->duration, "Longest run (log buffer size); stops earlier on SIGINT/SIGTERM/SIGHUP");
+  add_duration(slave, so->duration, "Longest run; stops earlier on SIGINT/SIGTERM/SIGHUP");
   slave->add_option("--log", so->log, "Per-step CSV log");
   slave->add_option("--stats", so->stats, "Statistics JSON");
   slave->add_option("--seed", so->seed, "Noise seed (-1 = from the settings)")->check(CLI::Range(std::int64_t{-1}, INT64_MAX));
@@ -208,7 +274,13 @@ void add_hil_nodes(CLI::App* hil, std::function<int()>& run_selected) {
   add_duration(lat, lo->duration, "Measurement time");
   lat->add_flag("--json", lo->json_out, "Print the statistics as one JSON object");
 
+  auto launch = std::make_shared<std::string>();
+  auto* node = hil->add_subcommand("node", "A node of `lash hil run`, from its launch file");
+  node->group("");  // hidden: started by `lash hil run` (hil/launch.hpp)
+  node->add_option("launch", *launch, "Launch file (JSON) written by `lash hil run`")->required();
+
   run_selected = [=]() -> int {
+    if (node->parsed()) return run_node(*launch);
     if (slave->parsed()) return run_slave(*so);
     if (master->parsed()) return run_master(*mo);
     if (lat->parsed()) return run_latency(*lo);

@@ -9,6 +9,7 @@
 #include "lash/hil/report.hpp"
 #include "lash/hil/schedule.hpp"
 #include "lash/hil/session.hpp"
+#include "lash/hil/sim_run.hpp"
 #include "lash/hil/simulate.hpp"
 
 namespace lash::cli::hilcli {
@@ -83,8 +84,15 @@ void print_report(const hil::RunReport& r) {
     if (g.restarted_s >= 0)
       fmt::print("slave died at t = {:.3f} s and was restarted at t = {:.3f} s (gap {:.3f} s)\n", g.died.t_s,
                  g.restarted_s, g.gap_s());
+  auto recovered = [](const char* who, const std::optional<hil::LogRecovery>& rec) {
+    if (rec)
+      fmt::print("{} handed nothing over (killed): recovered {} rows up to t = {:.3f} s from {}{}\n", who, rec->rows,
+                 rec->last_t_s, rec->file, rec->cut_lines ? " (an unfinished last line dropped)" : "");
+  };
+  recovered("master", r.master_recovered);
+  recovered("slave", r.slave_recovered);
   if (!r.have_master) {
-    fmt::print("no master log (the master handed nothing over)\n");
+    fmt::print("no master log (the master handed nothing over and left no row in master.csv)\n");
     return;
   }
   fmt::print("CCP handshake {:.4f} s; {} control steps\n", r.handshake_s, r.control_steps);
@@ -130,9 +138,11 @@ int run_run(const RunOptions& o) {
   so.duration_s = o.duration;
   if (so.settings.scenario) {  // the scenario's duration unless --duration is given
     if (!o.duration_given) so.duration_s = so.settings.scenario->duration_s;
-    so.node_args = {"--scenario", o.common.scenario, "--compensation", o.common.compensation};
+    so.scenario = o.common.scenario;
+    so.compensation = o.common.compensation;
   }
-  for (auto& a : controller_option_args(o.common.controller)) so.node_args.push_back(std::move(a));
+  so.controller = controller_override_keys(o.common.controller);
+  so.node_command = {"/proc/self/exe", "hil", "node"};  // `lash hil node LAUNCH.json` (cmd_hil_nodes.cpp)
   so.reference = o.reference;
   so.out_dir = o.out_dir;
   so.isolate = !o.no_isolate;
@@ -177,40 +187,37 @@ int run_simulate(const SimulateOptions& o) {
   const hil::BenchLayout L = hil::BenchLayout::from_dbc(s.dbc_file);
   const hil::SlaveConfig sc = hil::slave_config(s, L);
   const hil::MasterConfig mc = hil::master_config(s, o.reference);
+  hil::SimulationFileRun run;
   std::size_t N = 0;
-  hil::SimulationResult sim;
-  if (o.schedule.empty()) {
+  if (o.schedule.empty()) {  // streamed: memory independent of --duration (docs/hil.md)
     N = hil::steps_for(duration, s.step_s, "--duration");
-    sim = hil::simulate_bench(L, mc, sc, hil::ideal_schedule(N));
+    run = hil::simulate_to_csv(L, mc, sc, hil::lazy_ideal_schedule(N), s.step_s, o.out,
+                               s.scenario ? &*s.scenario : nullptr);
   } else {  // the run's own schedule: as many control steps as master.csv holds
     const std::filesystem::path mpath(o.schedule);
     const std::filesystem::path spath =
         o.slave_schedule.empty() ? mpath.parent_path() / "slave.csv" : std::filesystem::path(o.slave_schedule);
-    const hil::FrameSchedule fs = hil::read_schedule(mpath, spath);
-    sim = hil::simulate_bench(L, mc, sc, fs);
-    N = std::min(fs.master.size(), sim.slave.size());
-    const hil::SimulationDiff d = hil::compare_with_simulation(hil::read_master_trace(mpath), sim.master);
+    hil::FrameSchedule fs = hil::read_schedule(mpath, spath);
+    const std::size_t logged = fs.master.size();
+    const std::size_t kept = hil::replayable_control_steps(fs);
+    if (kept < logged) {  // a slave killed before the master: its log ends first
+      fmt::print("schedule of {}: the slave's log ({} steps) ends before the master's; replaying the first {} of {} "
+                 "control steps\n",
+                 o.schedule, fs.slave.size(), kept, logged);
+      fs.master.resize(kept);
+    }
+    const std::vector<hil::MasterStepLog> trace = hil::read_master_trace(mpath);
+    run = hil::simulate_to_csv(L, mc, sc, fs, s.step_s, o.out, s.scenario ? &*s.scenario : nullptr, &trace);
     fmt::print("schedule of {} ({} control steps): max |log - simulation| {} kPa, {} mA over {} steps\n", o.schedule,
-               fs.master.size(), format_double(d.max_abs_diff_kPa), format_double(d.max_abs_diff_mA), d.compared);
+               fs.master.size(), format_double(run.vs_log->max_abs_diff_kPa),
+               format_double(run.vs_log->max_abs_diff_mA), run.vs_log->compared);
   }
-  std::vector<double> c_m, c_t, c_r, c_y, c_i, c_p;
-  for (std::size_t m = 0; m < N; ++m) {
-    const auto& ml = sim.master[m + 1];
-    c_m.push_back(static_cast<double>(ml.control_step));
-    c_t.push_back(static_cast<double>(m) * s.step_s);
-    c_r.push_back(ml.reference_kPa);
-    c_y.push_back(ml.measured_kPa);
-    c_i.push_back(ml.current_mA);
-    c_p.push_back(sim.slave[m].pressure_kPa);
-  }
-  write_columns_csv(o.out, {"control_step", "t_s", "reference_kPa", "measured_kPa", "current_mA", "pressure_kPa"},
-                    {&c_m, &c_t, &c_r, &c_y, &c_i, &c_p});
-  fmt::print(stderr, "lash hil simulate: {} steps at {} ms -> {}\n", N, format_double(s.step_s * 1e3), o.out);
-  if (s.scenario) {
-    print_scenario(hil::scenario_figures(*s.scenario, s.step_s, sim.master, sim.slave, sim.compensation));
+  fmt::print(stderr, "lash hil simulate: {} steps at {} ms -> {}\n", run.rows, format_double(s.step_s * 1e3), o.out);
+  if (run.scenario) {
+    print_scenario(*run.scenario);
     return kExitOk;
   }
-  if (const auto sr = hil::step_response(c_r, s.step_s, c_p))
+  if (const auto& sr = run.step)
     fmt::print("step {} -> {} kPa at t = {} s: 90% rise {:.4f} s, 10% settling {:.4f} s, overshoot {:.1f} %\n",
                format_double(sr->window.y0), format_double(sr->window.y1), format_double(sr->window.t_step_s),
                sr->plant.rise_s, sr->plant.settling_s, sr->plant.overshoot_pct);

@@ -89,6 +89,53 @@ std::optional<StepResponse> step_response(const std::vector<double>& reference_k
   return r;
 }
 
+StepResponseStream::StepResponseStream(double dt_s, bool with_measured, double min_hold_s, double max_window_s)
+    : dt_s_(dt_s),
+      min_hold_s_(min_hold_s),
+      with_measured_(with_measured),
+      max_n_(round_clamped<std::size_t>(max_window_s / dt_s, 0, std::numeric_limits<std::size_t>::max())) {}
+
+// find_step() one sample at a time: the window is the samples k.. of the first jump whose level
+// was held min_hold_s, up to the next jump or max_window_s.
+void StepResponseStream::add(double r, double p, double y) {
+  const std::size_t k = k_++;
+  if (open_) {
+    if (r == w_.y1 && k - w_.begin < max_n_) {
+      p_.push_back(p);
+      if (with_measured_) y_.push_back(y);
+      w_.end = k + 1;
+    } else {
+      open_ = false;
+    }
+  } else if (!found_ && k > 0 && r != prev_) {
+    const double held = static_cast<double>(k - level_start_) * dt_s_;
+    if (held + 1e-12 >= min_hold_s_) {
+      found_ = open_ = true;
+      w_.begin = k;
+      w_.end = k + 1;
+      w_.t_step_s = static_cast<double>(k) * dt_s_;
+      w_.y0 = prev_;
+      w_.y1 = r;
+      p_.push_back(p);
+      if (with_measured_) y_.push_back(y);
+    } else {
+      level_start_ = k;
+    }
+  }
+  prev_ = r;
+}
+
+std::optional<StepResponse> StepResponseStream::result() const {
+  if (!found_) return std::nullopt;
+  std::vector<double> t;
+  for (std::size_t i = w_.begin; i < w_.end; ++i) t.push_back(static_cast<double>(i) * dt_s_);
+  StepResponse r;
+  r.window = w_;
+  r.plant = step_metrics(t, p_, w_.t_step_s, w_.y0, w_.y1);
+  if (with_measured_) r.measured = step_metrics(t, y_, w_.t_step_s, w_.y0, w_.y1);
+  return r;
+}
+
 std::size_t off_schedule_steps(const std::vector<MasterStepLog>& master, const std::vector<SlaveStepLog>& slave,
                                std::int64_t control_steps) {
   std::set<std::int64_t> off;
@@ -147,10 +194,13 @@ ScenarioFigures scenario_figures(const BenchScenario& s, double dt_s, const std:
 
 NodeFigures node_figures(const NodeStats& stats, const LoopTrace& loop) {
   NodeFigures f;
-  f.tet_us = rt::tet_us(loop.records);
-  f.io_us = rt::io_us(loop.records);
-  f.cycle_us = rt::cycle_us(loop.records);
-  f.wake_latency_us = rt::wake_latency_us(loop.records);
+  const bool kept = !loop.records.empty();  // else: the node's log writer's statistics
+  f.tet_us = kept ? rt::tet_us(loop.records) : stats.tet_us;
+  f.io_us = kept ? rt::io_us(loop.records) : stats.io_us;
+  f.cycle_us = kept ? rt::cycle_us(loop.records) : stats.cycle_us;
+  f.wake_latency_us = kept ? rt::wake_latency_us(loop.records) : stats.wake_latency_us;
+  f.logs = stats.logs;
+  f.peak_rss_kB = stats.peak_rss_kB;
   f.steps = stats.result.steps;
   f.overruns = stats.result.overruns;
   f.frames = stats.frames;
@@ -173,12 +223,14 @@ void make_run_report(RunReport& rep, const MasterRun* master, const std::vector<
   for (const auto& s : slaves) add(s.stats.frames);
   if (rep.have_slave) {
     rep.slave = node_figures(slaves[0].stats, slaves[0].loop);
+    rep.slave.recovered = rep.slave_recovered;
     rep.slave_events = slaves[0].events;
     rep.slave_state = slaves[0].stats.state;
   }
   if (!master) return;
   add(master->stats.frames);
   rep.master = node_figures(master->stats, master->loop);
+  rep.master.recovered = rep.master_recovered;
   rep.handshake_s = master->stats.handshake_s;
   rep.control_steps = master->stats.control_steps;
   rep.events = master->events;
@@ -213,7 +265,14 @@ json node_json(const NodeFigures& f) {
               {"steps", f.steps},
               {"frames", detail::frames_json(f.frames)},
               {"warnings", f.warnings},
-              {"dma_latency_held", f.dma_latency_held}};
+              {"dma_latency_held", f.dma_latency_held},
+              {"peak_rss_kB", f.peak_rss_kB},
+              {"logs", {{"rows", f.logs.rows}, {"ring_full", f.logs.ring_full}, {"writes", f.logs.writes}}},
+              {"recovered_from_log", f.recovered ? json{{"file", f.recovered->file},
+                                                        {"rows", f.recovered->rows},
+                                                        {"cut_lines", f.recovered->cut_lines},
+                                                        {"last_t_s", f.recovered->last_t_s}}
+                                                  : json(nullptr)}};
 }
 
 json exit_json(const NodeExit& e) {

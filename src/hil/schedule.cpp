@@ -48,8 +48,26 @@ std::string step_name(const char* node, std::int64_t step) {
   return std::string(node) + (node[0] == 'm' ? " control step " : " step ") + std::to_string(step);
 }
 
+/// The frames one node sent, numbered 0, 1, …; those a receiver has used are let go.
+class FrameHistory {
+ public:
+  void push(const can::Frame& f) { d_.push_back(f); }
+  std::int64_t size() const noexcept { return base_ + static_cast<std::int64_t>(d_.size()); }
+  const can::Frame& at(std::int64_t q) const { return d_[static_cast<std::size_t>(q - base_)]; }
+  void drop_through(std::int64_t q) {
+    while (base_ <= q && !d_.empty()) {
+      d_.pop_front();
+      ++base_;
+    }
+  }
+
+ private:
+  std::deque<can::Frame> d_;
+  std::int64_t base_ = 0;
+};
+
 /// Queues what a node received at a step that used frame `use.seq` after `last` (and sets last).
-void feed(FeedBus& bus, const FrameUse& use, std::int64_t& last, const std::vector<can::Frame>& sent,
+void feed(FeedBus& bus, const FrameUse& use, std::int64_t& last, FrameHistory& sent,
           const can::Frame& bad, const char* node, std::int64_t step) {
   if (use.seq < -1)
     throw std::invalid_argument("hil schedule: " + step_name(node, step) + " uses frame " + std::to_string(use.seq));
@@ -58,15 +76,16 @@ void feed(FeedBus& bus, const FrameUse& use, std::int64_t& last, const std::vect
                                 ", not newer than frame " + std::to_string(last) + " it used before");
   if (use.dropped) bus.in.push_back(bad);
   if (use.seq < 0) return;
-  for (std::int64_t q = last + 1; q <= use.seq; ++q) bus.in.push_back(sent[static_cast<std::size_t>(q)]);
+  for (std::int64_t q = last + 1; q <= use.seq; ++q) bus.in.push_back(sent.at(q));
   last = use.seq;
+  sent.drop_through(last);
 }
 
 /// Moves the frames with identifier `id` from bus.out to `to` (the others — CCP — need no delivery
 /// once connected: the master ignores a DTO after the handshake).
-void collect(FeedBus& bus, std::uint32_t id, std::vector<can::Frame>& to) {
+void collect(FeedBus& bus, std::uint32_t id, FrameHistory& to) {
   for (const auto& f : bus.out)
-    if (!f.extended && f.id == id) to.push_back(f);
+    if (!f.extended && f.id == id) to.push(f);
   bus.out.clear();
 }
 
@@ -113,6 +132,19 @@ FrameSchedule ideal_schedule(std::size_t control_steps) {
     s.master.push_back(FrameUse{static_cast<std::int64_t>(k), false});
     s.slave.push_back(FrameUse{static_cast<std::int64_t>(k) - 1, false});
   }
+  return s;
+}
+
+std::size_t replayable_control_steps(const FrameSchedule& s) noexcept {
+  const auto S = static_cast<std::int64_t>(s.slave.size());
+  for (std::size_t m = 0; m < s.master.size(); ++m)
+    if (s.master[m].seq >= S) return m;
+  return s.master.size();
+}
+
+FrameSchedule lazy_ideal_schedule(std::size_t control_steps) {
+  FrameSchedule s;
+  s.ideal_steps = control_steps;
   return s;
 }
 
@@ -180,18 +212,38 @@ std::vector<MasterStepLog> read_master_trace(const std::filesystem::path& master
 
 SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& master_cfg,
                                 const SlaveConfig& slave_cfg, const FrameSchedule& schedule) {
-  const std::size_t N = schedule.master.size();
+  SimulationResult r;
+  SimulationSink sink;
+  sink.master = [&r](const MasterStepLog& l) { r.master.push_back(l); };
+  sink.slave = [&r](const SlaveStepLog& l) { r.slave.push_back(l); };
+  SimulationResult s = simulate_bench(layout, master_cfg, slave_cfg, schedule, sink);
+  s.master = std::move(r.master);
+  s.slave = std::move(r.slave);
+  return s;
+}
+
+SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& master_cfg,
+                                const SlaveConfig& slave_cfg, const FrameSchedule& schedule,
+                                const SimulationSink& sink) {
+  const std::size_t N = schedule.master_steps();
   MasterConfig mc = master_cfg;
-  mc.log_capacity = N + 1;
+  mc.log_capacity = 1;  // one row, handed to the sink after each step
+  mc.bus_log_capacity = 1;
   if (!schedule.calibration.empty()) mc.calibration_schedule = schedule.calibration;
   SlaveConfig sc = slave_cfg;
-  sc.log_capacity = std::max(N, schedule.slave.size());
+  sc.log_capacity = 1;
   MasterNode master(layout, mc);
   SlaveNode slave(layout, sc);
+  auto master_step = [&](can::Bus& bus, double t) {
+    const bool ok = master.step(bus, t);
+    if (!master.log().empty() && sink.master) sink.master(master.log()[0]);
+    master.clear_step_logs();
+    return ok;
+  };
   const double T = mc.controller.pid.dt_s;
   FeedBus mb, sb;
   // Handshake: CRO → slave, DTO → master.
-  master.step(mb, 0.0);
+  master_step(mb, 0.0);
   sb.in.assign(mb.out.begin(), mb.out.end());
   mb.out.clear();
   if (!slave.wait_connect(sb, std::chrono::nanoseconds(0)))
@@ -201,23 +253,25 @@ SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& m
 
   const can::Frame bad_sensor = implausible(layout.pack_sensors(SensorMsg{}));
   const can::Frame bad_command = implausible(layout.pack_command(CommandMsg{}));
-  std::vector<can::Frame> sensors, commands;  // sent by slave step s / control step m
+  FrameHistory sensors, commands;  // sent by slave step s / control step m
   std::int64_t m = 0, s = 0, m_used = -1, s_used = -1;
-  const auto S = static_cast<std::int64_t>(schedule.slave.size());
+  const auto S = static_cast<std::int64_t>(schedule.slave_steps());
   auto slave_ready = [&] {
-    return s < S && schedule.slave[static_cast<std::size_t>(s)].seq < static_cast<std::int64_t>(commands.size());
+    return s < S && schedule.slave_use(static_cast<std::size_t>(s)).seq < commands.size();
   };
   auto slave_step = [&] {
-    feed(sb, schedule.slave[static_cast<std::size_t>(s)], s_used, commands, bad_command, "slave", s);
+    feed(sb, schedule.slave_use(static_cast<std::size_t>(s)), s_used, commands, bad_command, "slave", s);
     slave.step(sb, (static_cast<double>(s) + 0.5) * T);
+    if (!slave.log().empty() && sink.slave) sink.slave(slave.log()[0]);
+    slave.clear_step_log();
     collect(sb, layout.sensors_id, sensors);
     ++s;
   };
   while (m < static_cast<std::int64_t>(N)) {
-    const FrameUse& u = schedule.master[static_cast<std::size_t>(m)];
+    const FrameUse u = schedule.master_use(static_cast<std::size_t>(m));
     if (u.seq < s) {
       feed(mb, u, m_used, sensors, bad_sensor, "master", m);
-      if (!master.step(mb, static_cast<double>(m + 1) * T)) break;
+      if (!master_step(mb, static_cast<double>(m + 1) * T)) break;
       collect(mb, layout.command_id, commands);
       ++m;
     } else if (slave_ready()) {
@@ -226,7 +280,7 @@ SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& m
       throw std::invalid_argument(
           "hil schedule: not causal: master control step " + std::to_string(m) + " uses slave frame " +
           std::to_string(u.seq) + ", but slave step " + std::to_string(s) +
-          (s < S ? " uses command " + std::to_string(schedule.slave[static_cast<std::size_t>(s)].seq) +
+          (s < S ? " uses command " + std::to_string(schedule.slave_use(static_cast<std::size_t>(s)).seq) +
                        " of a later control step"
                  : " is past the end of the slave's schedule (" + std::to_string(S) + " steps)"));
     }
@@ -238,8 +292,6 @@ SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& m
                                 " (is the recorded DTO a positive CONNECT reply?)");
 
   SimulationResult r;
-  r.master.assign(master.log().begin(), master.log().end());
-  r.slave.assign(slave.log().begin(), slave.log().end());
   r.compensation = master.compensation();
   r.events.assign(master.events().begin(), master.events().end());
   return r;

@@ -7,6 +7,7 @@
 #include <time.h>
 
 #include <algorithm>
+#include <functional>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -67,6 +68,47 @@ Summary summarize(std::span<const double> values) {
   return s;
 }
 
+StreamSummary::StreamSummary(std::size_t max_n) : tail_cap_(max_n / 100 + 2) { tail_.reserve(tail_cap_); }
+
+void StreamSummary::add(double v) noexcept {
+  if (n_ == 0) {
+    min_ = max_ = v;
+  } else {
+    min_ = std::min(min_, v);
+    max_ = std::max(max_, v);
+  }
+  ++n_;
+  sum_ += v;
+  const double d = v - mean_;
+  mean_ += d / static_cast<double>(n_);
+  m2_ += d * (v - mean_);
+  const auto greater = std::greater<double>();
+  if (tail_.size() < tail_cap_) {
+    tail_.push_back(v);
+    std::push_heap(tail_.begin(), tail_.end(), greater);
+  } else if (v > tail_.front()) {
+    std::pop_heap(tail_.begin(), tail_.end(), greater);
+    tail_.back() = v;
+    std::push_heap(tail_.begin(), tail_.end(), greater);
+  }
+}
+
+Summary StreamSummary::result() const {
+  Summary s;
+  s.n = n_;
+  if (n_ == 0) return s;
+  s.min = min_;
+  s.max = max_;
+  s.mean = sum_ / static_cast<double>(n_);
+  if (n_ > 1) s.std = std::sqrt(m2_ / static_cast<double>(n_ - 1));
+  const auto rank = static_cast<std::size_t>(std::ceil(0.99 * static_cast<double>(n_)));
+  const std::size_t from_top = n_ - std::clamp<std::size_t>(rank, 1, n_);  // 0 = the largest
+  std::vector<double> t = tail_;
+  std::sort(t.begin(), t.end(), std::greater<double>());
+  s.p99 = t[std::min(from_top, t.size() - 1)];
+  return s;
+}
+
 const char* to_string(StopReason r) noexcept {
   switch (r) {
     case StopReason::completed: return "completed";
@@ -85,8 +127,8 @@ PeriodicLoop::PeriodicLoop(LoopConfig cfg) : cfg_(cfg) {
   if (cfg_.max_consecutive_overruns == 0) throw std::invalid_argument("rt: max_consecutive_overruns must be >= 1");
   if (cfg_.spin_ns < 0 || cfg_.spin_ns >= cfg_.period_ns)
     throw std::invalid_argument("rt: spin must be >= 0 and shorter than the period");
-  records_.resize(cfg_.max_steps);
-  overruns_.resize(cfg_.max_steps);
+  records_.resize(cfg_.keep_records ? cfg_.max_steps : 0);
+  overruns_.resize(cfg_.keep_records ? cfg_.max_steps : std::min(cfg_.max_steps, kMaxOverrunEvents));
 }
 
 namespace {

@@ -62,6 +62,16 @@ def e2e_crc(arbitration_id, data, crc_byte):
     return crc8_j1850(body)
 
 
+def node_role(argv):
+    """'slave' / 'master' for a node process of `lash hil run` (`lash hil node DIR/slave.launch.json`,
+    the launch file named after the node) or of `lash hil slave|master`; None otherwise."""
+    if len(argv) > 3 and argv[1] == "hil" and argv[2] == "node":
+        return os.path.basename(argv[3]).split(".")[0]
+    if len(argv) > 2 and argv[1] == "hil" and argv[2] in ("slave", "master"):
+        return argv[2]
+    return None
+
+
 def lash():
     return os.environ["LASH"]
 

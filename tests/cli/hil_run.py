@@ -2,7 +2,7 @@
 processes on the UDP bus in a private network namespace — gives max_abs_diff_vs_simulation_kPa
 == 0 (the thesis: emulated and simulated results matched identically), and reports the
 fields the issue names. Every difference must be explained by a late/lost frame: when a run
-has none, the difference is exactly 0; a busy machine gets up to three attempts."""
+has none, the difference is exactly 0; a busy machine gets up to five attempts (a loaded host (ctest -j2) stalls a vCPU for milliseconds now and then: a frame is then late, whatever the scheduler)."""
 import json
 import os
 import subprocess
@@ -27,7 +27,7 @@ REQUIRED = [
 ]
 
 clean = None
-for attempt in range(3):
+for attempt in range(5):
     out = tempfile.mkdtemp(prefix="lash_hil_run_")
     r = subprocess.run([hil_netns.lash(), "hil", "run", "--duration", "5", "--step-ms", "5", "--json", "--fifo", "50",
                         "--lock-memory", "--spin-us", "200", "--out-dir", out], capture_output=True, text=True, timeout=60)

@@ -47,7 +47,7 @@ def slave_of(run_pid, timeout=10.0):
     end = time.monotonic() + timeout
     while time.monotonic() < end:
         for pid, argv in children(run_pid).items():
-            if "slave" in argv:
+            if hil_netns.node_role(argv) == "slave":
                 return pid
         time.sleep(0.02)
     raise AssertionError(f"no slave process under {run_pid}")

@@ -70,9 +70,12 @@ p = run(["--duration", "8"], out)
 kids = wait_nodes(p.pid, 2)
 ns = procs()[p.pid][2]
 time.sleep(1.0)
-# The run's own files only: the stale ones are gone before any node writes.
-assert not any(os.path.exists(os.path.join(out, n)) for n in ("report.json", "master.csv", "slave.2.csv")), \
-    os.listdir(out)
+# The run's own files only: the stale ones are gone before any node writes (the nodes stream
+# master.csv and slave.csv from their first step: what is there now is this run's).
+for n in ("report.json", "master.csv", "slave.2.csv"):
+    path = os.path.join(out, n)
+    assert not os.path.exists(path) or "stale" not in open(path).read(), (n, os.listdir(out))
+assert not os.path.exists(os.path.join(out, "report.json")) and not os.path.exists(os.path.join(out, "slave.2.csv"))
 t_kill = time.time()
 p.send_signal(signal.SIGTERM)
 stdout, stderr = p.communicate(timeout=15)
@@ -110,7 +113,7 @@ out2 = tempfile.mkdtemp(prefix="lash_hil_session_")
 p = run(["--duration", "8"], out2)
 kids = wait_nodes(p.pid, 2)
 time.sleep(1.0)
-slave = next(pid for pid, argv in kids.items() if "slave" in argv)
+slave = next(pid for pid, argv in kids.items() if hil_netns.node_role(argv) == "slave")
 t_kill = time.time()
 os.kill(slave, signal.SIGKILL)
 stdout, stderr = p.communicate(timeout=15)
@@ -128,7 +131,7 @@ out3 = tempfile.mkdtemp(prefix="lash_hil_session_")
 p = run(["--duration", "4", "--restart-slave", "--reference", "step:from=500,to=1500,time=0.5"], out3)
 kids = wait_nodes(p.pid, 2)
 time.sleep(1.5)
-slave = next(pid for pid, argv in kids.items() if "slave" in argv)
+slave = next(pid for pid, argv in kids.items() if hil_netns.node_role(argv) == "slave")
 os.kill(slave, signal.SIGKILL)
 stdout, stderr = p.communicate(timeout=30)
 print(stderr)

@@ -99,6 +99,51 @@ TEST(HilSchedule, IdealScheduleEqualsTheLoopOverALink) {
   }
 }
 
+// The lazy ideal schedule (O(1) memory) and the streaming form of simulate_bench hand over the
+// rows of the loop written out over a link, and the streamed step response equals the one of
+// the whole trace (find_step + step_metrics).
+TEST(HilSchedule, StreamedSimulationEqualsTheLoopOverALink) {
+  const std::size_t N = 600;
+  BenchLayout L;
+  SimulationResult streamed;
+  SimulationSink sink;
+  sink.master = [&](const MasterStepLog& l) { streamed.master.push_back(l); };
+  sink.slave = [&](const SlaveStepLog& l) { streamed.slave.push_back(l); };
+  const SimulationResult r = simulate_bench(L, master_cfg(), slave_cfg(), lazy_ideal_schedule(N), sink);
+  EXPECT_TRUE(r.master.empty());
+  EXPECT_TRUE(r.slave.empty());
+  expect_same(streamed, memlink_loop(L, N));
+  std::vector<double> ref, p;
+  StepResponseStream stream(kT);
+  for (std::size_t m = 0; m < N; ++m) {
+    ref.push_back(streamed.master[m + 1].reference_kPa);
+    p.push_back(streamed.slave[m].pressure_kPa);
+    stream.add(ref.back(), p.back());
+  }
+  const auto whole = step_response(ref, kT, p);
+  const auto part = stream.result();
+  ASSERT_TRUE(whole && part);
+  EXPECT_EQ(part->window.begin, whole->window.begin);
+  EXPECT_EQ(part->window.end, whole->window.end);
+  EXPECT_EQ(part->plant.rise_s, whole->plant.rise_s);
+  EXPECT_EQ(part->plant.settling_s, whole->plant.settling_s);
+  EXPECT_EQ(part->plant.overshoot_pct, whole->plant.overshoot_pct);
+}
+
+// A schedule whose slave log ends early (a killed slave) is replayed up to the last control
+// step the slave's log can serve.
+TEST(HilSchedule, ReplayableStepsEndWhereTheSlaveLogEnds) {
+  FrameSchedule s = ideal_schedule(50);
+  EXPECT_EQ(replayable_control_steps(s), 50u);
+  s.slave.resize(30);  // slave steps 0..29 kept: control step 30 uses the sensor frame of slave step 30
+  EXPECT_EQ(replayable_control_steps(s), 30u);
+  s.master[29].seq = -1;  // held: still replayable
+  EXPECT_EQ(replayable_control_steps(s), 30u);
+  BenchLayout L;
+  s.master.resize(replayable_control_steps(s));
+  EXPECT_NO_THROW(simulate_bench(L, master_cfg(), slave_cfg(), s));
+}
+
 TEST(HilSchedule, LateAndSkippedFramesEqualHandWrittenLoop) {
   const std::size_t N = 400;
   FrameSchedule sch = ideal_schedule(N);

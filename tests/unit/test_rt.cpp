@@ -34,6 +34,57 @@ TEST(RtSummary, SmallSamplesAndEmpty) {
   EXPECT_DOUBLE_EQ(summarize(ten).p99, 10.0);  // ceil(9.9) = 10th
 }
 
+// The streamed statistics against summarize() over the same values: min, max and the nearest-rank
+// p99 exact (any n up to max_n), the mean bit for bit (same additions), the std to rounding.
+TEST(RtSummary, StreamEqualsSummarize) {
+  std::uint64_t x = 88172645463325252ULL;  // xorshift64: a fixed sequence with ties and outliers
+  auto next = [&] {
+    x ^= x << 13;
+    x ^= x >> 7;
+    x ^= x << 17;
+    return x;
+  };
+  for (std::size_t n : {1u, 2u, 99u, 100u, 101u, 199u, 200u, 201u, 1000u, 12345u}) {
+    StreamSummary s(20000);
+    std::vector<double> v;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double a = static_cast<double>(next() % 1000) * 0.25 + (next() % 97 == 0 ? 1e4 : 0.0);
+      v.push_back(a);
+      s.add(a);
+    }
+    const Summary want = summarize(v), got = s.result();
+    EXPECT_EQ(got.n, n);
+    EXPECT_EQ(got.min, want.min) << n;
+    EXPECT_EQ(got.max, want.max) << n;
+    EXPECT_EQ(got.p99, want.p99) << n;
+    EXPECT_EQ(got.mean, want.mean) << n;
+    EXPECT_NEAR(got.std, want.std, 1e-9 * (1.0 + want.std)) << n;
+  }
+  EXPECT_EQ(StreamSummary(10).result().n, 0u);
+}
+
+// Without kept records the loop hands every record to on_record and keeps none: constant memory.
+TEST(RtLoop, StreamedRecordsAreHandedOverNotKept) {
+  LoopConfig c;
+  c.period_ns = 200'000;
+  c.max_steps = 20;
+  c.keep_records = false;
+  PeriodicLoop loop(c);
+  std::vector<StepRecord> got;
+  got.reserve(20);
+  std::atomic<bool> stop{false};
+  const RunResult r = loop.run_with_io([]() noexcept {}, [](std::size_t, std::int64_t) noexcept { return true; },
+                                       []() noexcept {},
+                                       [&](std::size_t k, const StepRecord& rec) noexcept {
+                                         if (k == got.size()) got.push_back(rec);
+                                       },
+                                       stop);
+  EXPECT_EQ(r.steps, 20u);
+  EXPECT_TRUE(loop.records().empty());
+  ASSERT_EQ(got.size(), 20u);
+  for (std::size_t k = 0; k < got.size(); ++k) EXPECT_EQ(got[k].release_ns, static_cast<std::int64_t>(k) * 200'000);
+}
+
 TEST(RtLoop, RejectsBadConfig) {
   LoopConfig c;
   c.max_steps = 0;

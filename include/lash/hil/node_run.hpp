@@ -2,9 +2,12 @@
 /// @file node_run.hpp
 /// One node of the bench as a process runs it (`lash hil slave`, `lash hil master`, and the
 /// children of `lash hil run`): settings → node → emulated CAN controller on a bus → the
-/// periodic loop, and what a run leaves behind (logs, loop records, counters) in memory.
-/// The option checks live here too, so that every face of the library refuses the same
-/// values with the same message before any work. Not real-time code, except the loops it runs.
+/// periodic loop, its logs streamed to disk (log_writer.hpp), and what a run ends with
+/// (statistics, counters, events). The option checks live here too, so that every face of the
+/// library refuses the same values with the same message (naming the options' fields) before
+/// any work. Its neighbours by concern: handover.hpp (a run from the node process to its
+/// session), node_report.hpp (a run's files and statistics JSON), launch.hpp (a node's
+/// configuration as data, how a session starts it). Not real-time code, except the loops it runs.
 #include <array>
 #include <atomic>
 #include <cstddef>
@@ -16,6 +19,7 @@
 
 #include "lash/can/controller_bus.hpp"
 #include "lash/hil/e2e.hpp"
+#include "lash/hil/log_writer.hpp"
 #include "lash/hil/nodes.hpp"
 #include "lash/hil/settings.hpp"
 #include "lash/rt/periodic.hpp"
@@ -25,7 +29,8 @@ namespace lash::hil {
 /// Limits of the real-time options (documented in `--help`).
 inline constexpr double kMinStepMs = 0.1;     ///< shortest step the loop is let run [ms] (see docs/hil.md)
 inline constexpr double kMaxStepMs = 1000.0;  ///< longest step [ms]
-/// Most steps one run may record: 2e7 steps × (32 B loop record + < 64 B node log) < 2 GB.
+/// Most steps one run may take (a node streams its logs: its memory does not depend on it; the
+/// percentile tails of its statistics hold steps/100 values, 0.6 MB at this limit).
 inline constexpr std::size_t kMaxSteps = 20'000'000;
 
 /// Real-time options shared by the nodes and `lash hil latency`.
@@ -38,15 +43,16 @@ struct LoopOptions {
   rt::OverrunPolicy policy = rt::OverrunPolicy::tolerate;
   std::size_t max_overruns = 10;               ///< policy stop: consecutive overruns before stopping
   bool hold_dma_latency = true;                ///< hold /dev/cpu_dma_latency at 0 µs while the loop runs
-  /// Throws InputError naming the option (`--fifo`, `--step-ms`, …) for a value out of its range.
+  /// Throws InputError naming the field (`loop.fifo`, `loop.step_s`, …) for a value out of its
+  /// range (a face maps the field to its option in its message).
   void validate() const;
 };
 
-/// Parses `tolerate` / `stop`; throws InputError(field `--overrun-policy`) otherwise.
+/// Parses `tolerate` / `stop`; throws InputError(field `loop.policy`) otherwise.
 rt::OverrunPolicy parse_overrun_policy(const std::string& text);
-/// Steps of a run of `duration_s` at `step_s`: ≥ 1, and refused (InputError naming `option`)
+/// Steps of a run of `duration_s` at `step_s`: ≥ 1, and refused (InputError naming `field`)
 /// when not finite, ≤ 0 or above kMaxSteps.
-std::size_t steps_for(double duration_s, double step_s, const std::string& option);
+std::size_t steps_for(double duration_s, double step_s, const std::string& field);
 /// The loop configuration of `steps` steps (options validated first).
 rt::LoopConfig make_loop_config(const LoopOptions& o, std::size_t steps);
 
@@ -80,6 +86,11 @@ struct NodeStats {
   FrameStats frames;
   can::ControllerStats controller;
   bool dma_latency_held = false; ///< /dev/cpu_dma_latency was held at 0 during the loop
+  /// Loop statistics over every step [µs] (the log writer's, log_writer.hpp: the records are
+  /// not kept in memory).
+  rt::Summary tet_us, io_us, cycle_us, wake_latency_us;
+  LogStats logs;                 ///< what the log writer wrote, and the items a full ring refused
+  long peak_rss_kB = -1;         ///< the node process's peak resident set at the end of its run [kB] (getrusage)
   NodeState state = NodeState::startup;  ///< the safe-state machine's state at the end (nodes.hpp)
   // master only
   std::int64_t control_steps = 0;
@@ -118,12 +129,14 @@ struct MasterRun {
 
 struct SlaveRunOptions {
   LoopOptions loop;
+  LogPaths logs;                    ///< slave.csv, slave.events.csv (streamed while the node runs)
   double duration_s = 600.0;        ///< longest run (log size) [s]
   double connect_timeout_s = 0.0;   ///< 0 = wait for CONNECT until stopped
 };
 
 struct MasterRunOptions {
   LoopOptions loop;
+  LogPaths logs;                    ///< master.csv, master.events.csv, master_bus.log (streamed)
   double duration_s = 10.0;         ///< control time after the handshake [s]
   std::string reference = "step:from=500,to=1500,time=1";
   double dto_timeout_s = 0.0;       ///< 0 = from the settings
@@ -132,6 +145,9 @@ struct MasterRunOptions {
 
 /// Runs the slave: waits for a CCP CONNECT (polling `stop`), then steps until `stop`, the
 /// duration or an overrun stop. `on_ready(address)` is called once the bus is open.
+/// Both runs stream their logs to o.logs while they run (log_writer.hpp): the returned run's
+/// `log` (and the master's `bus_log`) are empty, its loop records too; the statistics are in
+/// `stats`. A node killed outright leaves its logs on disk up to the last flush.
 SlaveRun run_slave_node(const BenchSettings& s, const SlaveRunOptions& o, const std::atomic<bool>& stop,
                         const std::function<void(const std::string&)>& on_ready = {});
 /// Runs the master: CONNECT, then `duration_s` of control (or until `stop`).
@@ -142,29 +158,8 @@ MasterRun run_master_node(const BenchSettings& s, const MasterRunOptions& o, con
 const std::atomic<bool>& node_stop_flag() noexcept;
 void install_node_signal_handlers();
 
-/// Log files of a run (atomic writes; columns documented in docs/hil.md).
-void write_slave_csv(const std::filesystem::path& path, const SlaveRun& r);
-void write_master_csv(const std::filesystem::path& path, const MasterRun& r);
-/// A node's events CSV: `step,t_s,event,from,to`.
-void write_events(const std::filesystem::path& path, const std::vector<NodeEvent>& events);
-/// The master's events CSV: `step,t_s,event,from,to,name,old,new`, the state events and the
-/// calibration writes (event `calibration`, the object's name, its old and new value) in step order.
-void write_events(const std::filesystem::path& path, const std::vector<NodeEvent>& events,
-                  const std::vector<CalibrationEvent>& calibration);
-/// candump -L log of the frames the master sent and received, in wall-clock seconds: a sent
-/// frame carries its loop time (added to the loop's epoch), a received one the bus's receive
-/// timestamp, which is wall-clock already.
-void write_bus_log(const std::filesystem::path& path, const MasterRun& r);
-/// The statistics JSON of `lash hil slave/master --stats`.
-std::string slave_stats_json(const SlaveRun& r);
-std::string master_stats_json(const MasterRun& r, const std::string& reference);
-
-/// Binary hand-over of a run from a node process to its session (same executable on both
-/// sides): write at the end of the run to an inherited descriptor, read back after it exited.
-/// read_* returns false when the node wrote nothing (it was killed) or the data are cut short.
-void write_run(int fd, const SlaveRun& r);
-void write_run(int fd, const MasterRun& r);
-bool read_run(int fd, SlaveRun& r);
-bool read_run(int fd, MasterRun& r);
-
 }  // namespace lash::hil
+
+// The hand-over of a run (write_run / read_run, the logs read back) lived in this header before
+// it was split by concern; it is included for the code that still finds it here.
+#include "lash/hil/handover.hpp"  // IWYU pragma: export

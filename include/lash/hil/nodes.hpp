@@ -52,6 +52,9 @@ namespace lash::hil {
 /// Most frames a node reads from the bus in one step; a babbling node cannot stretch a step further.
 inline constexpr std::size_t kMaxDrain = 64;
 
+/// Most frames a master logs in one step: kMaxDrain received, a CRO and a command sent, margin.
+inline constexpr std::size_t kStepFrames = kMaxDrain + 8;
+
 /// A frame as a node saw it, for the candump log.
 struct LoggedFrame {
   can::Frame frame;
@@ -180,7 +183,7 @@ struct CompensationState {
 struct SlaveConfig {
   PilotValveParams plant;                 ///< docs/method.md §B1 (dt_s = the step)
   std::vector<can::Frame> dto_reply;      ///< the recorded DTO frame(s), replayed on every CONNECT
-  std::size_t log_capacity = 0;           ///< steps logged (preallocated)
+  std::size_t log_capacity = 0;           ///< steps logged (preallocated; 1 with clear_step_log() per step)
   E2EConfig e2e;                          ///< plausibility, recovery and ramp settings
   std::uint32_t stale_periods = 3;        ///< steps without a plausible command → degraded
   double current_min_mA = 0.0;            ///< the current driver's range: the output is clamped to it [mA]
@@ -221,6 +224,9 @@ class SlaveNode {
   std::uint64_t dto_replies() const noexcept { return dto_replies_; }
   std::uint64_t ignored_frames() const noexcept { return ignored_; }
   std::uint32_t steps() const noexcept { return step_; }
+  /// Empties the step log for the next step. A node run with log_capacity = 1 calls it after
+  /// handing each step's row to its log writer (node_run.hpp): constant memory. noexcept.
+  void clear_step_log() noexcept { n_log_ = 0; }
 
  private:
   void reply_dto(can::Bus& bus) noexcept;
@@ -251,7 +257,7 @@ struct MasterConfig {
   double dto_timeout_s = 2.0;              ///< no DTO by then → failed (clear error)
   std::uint32_t fault_missed_periods = 3;  ///< steps without a plausible sensor frame → safe (0 mA)
   std::uint32_t cro_retry_steps = 10;      ///< CRO repeat period while connecting / stale in safe [steps]
-  std::size_t log_capacity = 0;            ///< steps logged (preallocated)
+  std::size_t log_capacity = 0;            ///< steps logged (preallocated; 1 with clear_step_logs() per step)
   std::size_t bus_log_capacity = 0;        ///< frames logged (preallocated); 0 → 4·log_capacity + 64
   E2EConfig e2e;                           ///< plausibility, recovery and ramp settings
   std::optional<CompensatedLaw> law;       ///< a scenario's law instead of `controller`'s PID + fixed offset
@@ -316,6 +322,13 @@ class MasterNode {
   /// detaches. Not real-time safe (call before the loop).
   void attach(XcpLink* link) noexcept { link_ = link; }
   const CalibrationPage& calibration() const noexcept { return cal_; }
+  /// Empties the step log and the bus log for the next step. A node run with log_capacity = 1
+  /// and bus_log_capacity = kStepFrames calls it after handing each step's row and frames to
+  /// its log writer (node_run.hpp): constant memory. noexcept.
+  void clear_step_logs() noexcept {
+    n_log_ = 0;
+    n_bus_log_ = 0;
+  }
   /// Calibration writes that took effect, one event per changed object.
   std::span<const CalibrationEvent> calibration_events() const noexcept { return {cal_events_.data(), n_cal_events_}; }
 

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "lash/metrics/step_response.hpp"
+#include "lash/hil/handover.hpp"
 #include "lash/hil/node_run.hpp"
 #include "lash/hil/nodes.hpp"
 #include "lash/hil/settings.hpp"
@@ -56,6 +57,26 @@ std::optional<StepResponse> step_response(const std::vector<double>& reference_k
                                           const std::vector<double>& pressure_kPa,
                                           const std::vector<double>* measured_kPa = nullptr);
 
+/// step_response() over a trace given sample by sample, in constant memory (it keeps only the
+/// step's window, at most max_window_s): the same figures as step_response() on the whole trace.
+class StepResponseStream {
+ public:
+  explicit StepResponseStream(double dt_s, bool with_measured = false, double min_hold_s = 0.5,
+                              double max_window_s = 2.0);
+  void add(double reference_kPa, double pressure_kPa, double measured_kPa = 0.0);
+  std::optional<StepResponse> result() const;
+
+ private:
+  double dt_s_, min_hold_s_;
+  bool with_measured_;
+  std::size_t max_n_;
+  std::size_t k_ = 0, level_start_ = 0;
+  double prev_ = 0.0;
+  bool found_ = false, open_ = false;
+  StepWindow w_;
+  std::vector<double> p_, y_;
+};
+
 /// Control steps that consumed another frame than the one meant for them: master step m must
 /// use the sensor frame of slave step m (fresh, counter m modulo 2¹⁶), slave step s
 /// (0 < s < control_steps) the command of master step s − 1 (fresh, unwrapped counter s − 1).
@@ -87,8 +108,19 @@ struct ScenarioFigures {
 ScenarioFigures scenario_figures(const BenchScenario& s, double dt_s, const std::vector<MasterStepLog>& master,
                                  const std::vector<SlaveStepLog>& slave, const CompensationState& compensation);
 
+/// A node that handed nothing over (it was killed): what the session read back from its CSV log.
+struct LogRecovery {
+  std::string file;            ///< the log read
+  std::size_t rows = 0;        ///< whole rows kept
+  std::size_t cut_lines = 0;   ///< an unfinished last line, dropped
+  double last_t_s = -1.0;      ///< t_s of the last row kept [s] (loop time of the node)
+};
+
 /// Loop figures of one node [µs] and its counters.
 struct NodeFigures {
+  std::optional<LogRecovery> recovered;  ///< set when the node was killed (figures from its log only)
+  LogStats logs;                         ///< its log writer's counters (ring_full: items not written)
+  long peak_rss_kB = -1;                 ///< its peak resident set [kB]; −1: not handed over
   rt::Summary tet_us, io_us, cycle_us, wake_latency_us;
   std::size_t steps = 0, overruns = 0;
   FrameStats frames;
@@ -139,10 +171,12 @@ struct RunReport {
   std::string observed_schedule_note;
   std::size_t off_schedule = 0;
   std::optional<ScenarioFigures> scenario;  ///< --scenario runs
+  std::optional<LogRecovery> master_recovered, slave_recovered;  ///< a node killed: what its log kept
 };
 
 /// Fills the computed part of `report` from the master's run, the slaves' runs (first = the one
 /// started with the master) and the simulation of the same control steps (simulate_bench).
+/// A run's `log` (and loop records) are what the session read back from the node's CSV log.
 void make_run_report(RunReport& report, const MasterRun* master, const std::vector<SlaveRun>& slaves,
                      const std::vector<MasterStepLog>& simulated, const BenchScenario* scenario = nullptr);
 /// The scenario part of report.json and of `lash closed-loop --json` on a valve scenario:

@@ -16,6 +16,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <vector>
 
 #include "lash/hil/nodes.hpp"
@@ -41,15 +42,39 @@ struct FrameSchedule {
   /// simulate_bench applies them through MasterConfig::calibration_schedule. Empty for logs
   /// without calibration columns.
   std::vector<MasterConfig::CalibrationChange> calibration;
+  /// > 0: the ideal schedule of this many control steps, not stored (master and slave empty):
+  /// lazy_ideal_schedule(), for simulations whose memory must not grow with their duration.
+  std::size_t ideal_steps = 0;
+  std::size_t master_steps() const noexcept { return ideal_steps ? ideal_steps : master.size(); }
+  std::size_t slave_steps() const noexcept { return ideal_steps ? ideal_steps : slave.size(); }
+  FrameUse master_use(std::size_t m) const noexcept {
+    return ideal_steps ? FrameUse{static_cast<std::int64_t>(m), false} : master[m];
+  }
+  FrameUse slave_use(std::size_t s) const noexcept {
+    return ideal_steps ? FrameUse{static_cast<std::int64_t>(s) - 1, false} : slave[s];
+  }
+};
+
+/// What simulate_bench's streaming form hands on, row by row, as the nodes' steps produce them.
+struct SimulationSink {
+  std::function<void(const MasterStepLog&)> master;  ///< every master step (the connecting step included)
+  std::function<void(const SlaveStepLog&)> slave;    ///< every slave step
 };
 
 /// The schedule of simulate_bench: master m uses slave frame m, slave s uses command s − 1.
 FrameSchedule ideal_schedule(std::size_t control_steps);
+/// The same schedule in O(1) memory (FrameSchedule::ideal_steps).
+FrameSchedule lazy_ideal_schedule(std::size_t control_steps);
 
 /// The schedule the nodes logged in a run (control steps of the master log, every slave step).
 /// The master's `sensor_seq` is the sensor frame's alive counter unwrapped (= the slave step
 /// that sent it), the slave's `command_counter` the command's counter unwrapped (= the control step).
 FrameSchedule observed_schedule(const std::vector<MasterStepLog>& master, const std::vector<SlaveStepLog>& slave);
+
+/// Control steps of `s` that the slave's schedule can serve: the master's schedule up to the
+/// first control step that uses a sensor frame of a slave step past its end (a killed slave's
+/// log ends earlier than the master's). simulate_bench replays that many without refusing.
+std::size_t replayable_control_steps(const FrameSchedule& s) noexcept;
 
 /// Reads the schedule of a run from its logs: master.csv (columns control_step, sensor_seq,
 /// dropped) and slave.csv (command_counter, command_fresh, dropped). Throws InputError naming
@@ -68,5 +93,11 @@ std::vector<MasterStepLog> read_master_trace(const std::filesystem::path& master
 /// its sender has not sent yet, or an older one than before), naming the step.
 SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& master, const SlaveConfig& slave,
                                 const FrameSchedule& schedule);
+/// The same simulation in memory independent of its length: each row goes to `sink` when its
+/// node's step produced it (the result's master and slave vectors stay empty; events and the
+/// compensation are filled), and frames are kept only until the step that uses them.
+/// The rows are those of the form above, bit for bit, in the same order per node.
+SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& master, const SlaveConfig& slave,
+                                const FrameSchedule& schedule, const SimulationSink& sink);
 
 }  // namespace lash::hil

@@ -1,8 +1,11 @@
 #pragma once
 /// @file session.hpp
-/// `lash hil run`: the slave and the master as two processes of this executable (fork/exec
-/// of `lash hil slave` / `lash hil master`) on a bus in a private network namespace, supervised
-/// until the master is done, and the run report computed from their runs in memory.
+/// `lash hil run`: the slave and the master as two processes on a bus in a private network
+/// namespace, supervised until the master is done, and the run report. Each node is started
+/// from a launch file (launch.hpp: the node's configuration as data, written by the session)
+/// with the command the face gives (node_command); the session writes no command line.
+/// By concern: process control (process.hpp, private), the hand-over (handover.hpp: statistics
+/// in a memory file, logs read back from disk), the report (report.hpp).
 ///
 /// Supervision:
 ///   - a stop signal to the session (SIGTERM, SIGINT, SIGHUP; see stop_signal()) is forwarded
@@ -13,13 +16,16 @@
 ///   - the nodes die with the session (PR_SET_PDEATHSIG) if it is killed outright;
 ///   - the files a run owns are removed from the output directory before it starts, so a
 ///     file from an earlier run never sits beside new logs.
-/// Each node hands its run to the session through an inherited memory file (node_run.hpp:
-/// write_run/read_run); its CSV and JSON files are written by the node itself.
+/// Each node hands its run's statistics to the session through an inherited memory file
+/// (handover.hpp); its CSV logs are streamed by the node itself while it runs (log_writer.hpp)
+/// and read back by the session, also when the node was killed (the report says what it
+/// recovered).
 /// Not real-time code; the session process itself runs no loop.
 #include <atomic>
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "lash/hil/node_run.hpp"
@@ -39,15 +45,23 @@ struct SessionOptions {
   std::filesystem::path out_dir = "hil-out";
   bool isolate = true;                   ///< private network namespace (else the host's network)
   bool restart_slave = false;            ///< watchdog: start a dead slave again
-  std::string executable = "/proc/self/exe";  ///< the lash binary the nodes run
-  /// Passed on to both nodes (`--scenario FILE --compensation MODE`: the nodes load the
-  /// scenario themselves; `settings.scenario` must hold the same for the report).
-  std::vector<std::string> node_args;
+  /// The command that runs a node from a launch file (launch.hpp), given by the face: [0] is
+  /// the executable; the session appends the launch file's path. E.g. {"/proc/self/exe", "hil",
+  /// "node"} for the lash executable.
+  std::vector<std::string> node_command;
+  /// The closed-loop scenario both nodes load themselves (`settings.scenario` must hold the same
+  /// for the report), and its compensation mode; "" = none.
+  std::filesystem::path scenario;
+  std::string compensation;
+  /// Controller overrides both nodes apply after the settings' controller: ("table.key" of
+  /// controller_fields(), value text).
+  std::vector<std::pair<std::string, std::string>> controller;
   /// Called once both nodes were started, in the session's network namespace (the private one
   /// when isolated), e.g. to start a tool that joins the bus (the console's XCP client).
   std::function<void()> on_nodes_started;
   /// Checks what can be checked before any process starts (reference, duration, loop options,
-  /// output directory writable); throws InputError naming the option.
+  /// output directory writable, a node command); throws InputError naming the field
+  /// (`duration_s`, `loop.fifo`, `out_dir`, …).
   void validate() const;
 };
 

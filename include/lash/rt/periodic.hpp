@@ -11,7 +11,9 @@
 ///   - with run_with_io(), the I/O time around the task: an input phase before it and an
 ///     output phase after it (an emulated CAN controller's reception and transmission,
 ///     can/controller_bus.hpp), timed apart from the TET; the cycle is I/O + TET,
-/// into a buffer preallocated for the whole run (no allocation on the sample path).
+/// into a buffer preallocated for the whole run (no allocation on the sample path), or, with
+/// LoopConfig::keep_records = false, only to an on_record callback (run_with_io's streaming
+/// form): the loop's memory is then constant, whatever the number of steps.
 /// An overrun is a step whose cycle misses its deadline r_k + T: it starts after it
 /// (released late by more than a period) or is still running at it. Overruns
 /// are counted and timestamped; a late step is run at once (the grid is kept,
@@ -47,7 +49,14 @@ struct LoopConfig {
   std::int64_t spin_ns = 0;                ///< sleep until r_k − spin_ns, then busy-wait to r_k (0 = sleep only)
   OverrunPolicy policy = OverrunPolicy::tolerate;
   std::size_t max_consecutive_overruns = 10;  ///< policy stop: stop after this many in a row (≥ 1)
+  /// true: every step's record is kept (records(), a buffer of max_steps records) and every
+  /// overrun event; false: records go only to the on_record callback and at most
+  /// kMaxOverrunEvents overrun events are kept (all are counted): constant memory.
+  bool keep_records = true;
 };
+
+/// Overrun events a loop keeps when it does not keep its records (the rest are only counted).
+inline constexpr std::size_t kMaxOverrunEvents = 4096;
 
 /// One step as it happened.
 struct StepRecord {
@@ -71,6 +80,25 @@ struct Summary {
 };
 /// mean/min/max/std and the 99th percentile (nearest rank: the ⌈0.99·n⌉-th smallest).
 Summary summarize(std::span<const double> values);
+
+/// The same statistics over a stream of at most max_n values, in O(max_n/100) memory: the sum
+/// (mean equal bit for bit to summarize()'s, same order of additions), Welford's running
+/// variance (std equal to summarize()'s up to rounding), min, max, and the ⌈max_n/100⌉ + 2
+/// largest values seen, which hold the nearest-rank 99th percentile of any n ≤ max_n values
+/// exactly (n − ⌈0.99·n⌉ + 1 ≤ ⌊n/100⌋ + 1 of them lie at or above it). The tail is reserved
+/// at construction: add() is noexcept-safe, allocation-free and O(log(max_n/100)).
+class StreamSummary {
+ public:
+  explicit StreamSummary(std::size_t max_n = 0);
+  void add(double v) noexcept;
+  Summary result() const;
+  std::size_t count() const noexcept { return n_; }
+
+ private:
+  std::size_t n_ = 0, tail_cap_ = 2;
+  double sum_ = 0.0, mean_ = 0.0, m2_ = 0.0, min_ = 0.0, max_ = 0.0;
+  std::vector<double> tail_;  ///< min-heap of the largest values
+};
 
 /// The same statistics over records [µs] (what PeriodicLoop's members return for its own).
 Summary tet_us(std::span<const StepRecord> records);
@@ -110,10 +138,21 @@ class PeriodicLoop {
   /// the deadline applies to the whole cycle.
   template <class Input, class Step, class Output>
   RunResult run_with_io(Input&& input, Step&& step, Output&& output, const std::atomic<bool>& stop) noexcept {
+    return run_with_io(std::forward<Input>(input), std::forward<Step>(step), std::forward<Output>(output),
+                       [](std::size_t, const StepRecord&) noexcept {}, stop);
+  }
+
+  /// As run_with_io(), and on_record(k, record) (noexcept) is called once per step after the
+  /// output phase, outside the timed cycle, with the step's record: the streaming form (a
+  /// node pushes its step's log and the record into its log writer's ring there).
+  template <class Input, class Step, class Output, class OnRecord>
+  RunResult run_with_io(Input&& input, Step&& step, Output&& output, OnRecord&& on_record,
+                        const std::atomic<bool>& stop) noexcept {
     const std::int64_t T = cfg_.period_ns;
     start_ns_ = cfg_.start_ns != 0 ? cfg_.start_ns : monotonic_ns() + T;
     n_records_ = 0;
     n_overruns_ = 0;
+    std::size_t steps = 0;
     RunResult res;
     std::size_t consecutive = 0;
     for (std::size_t k = 0; k < cfg_.max_steps; ++k) {
@@ -138,10 +177,14 @@ class PeriodicLoop {
       const std::int64_t e_task = monotonic_ns();
       output();
       const std::int64_t e = monotonic_ns();
-      records_[n_records_++] = StepRecord{r - start_ns_, s - r, e_task - s_task, (s_task - s) + (e - e_task)};
+      const StepRecord rec{r - start_ns_, s - r, e_task - s_task, (s_task - s) + (e - e_task)};
+      if (n_records_ < records_.size()) records_[n_records_++] = rec;
+      ++steps;
+      on_record(k, rec);
       const std::int64_t deadline = r + T;
       if (e > deadline) {
-        overruns_[n_overruns_++] = OverrunEvent{k, s - start_ns_, e - deadline};
+        if (n_overruns_ < overruns_.size()) overruns_[n_overruns_] = OverrunEvent{k, s - start_ns_, e - deadline};
+        ++n_overruns_;
         if (++consecutive >= cfg_.max_consecutive_overruns && cfg_.policy == OverrunPolicy::stop) {
           res.reason = StopReason::overruns;
           break;
@@ -154,7 +197,7 @@ class PeriodicLoop {
         break;
       }
     }
-    res.steps = n_records_;
+    res.steps = steps;
     res.overruns = n_overruns_;
     return res;
   }
@@ -165,7 +208,10 @@ class PeriodicLoop {
   const LoopConfig& config() const noexcept { return cfg_; }
   std::int64_t start_ns() const noexcept { return start_ns_; }
   std::span<const StepRecord> records() const noexcept { return {records_.data(), n_records_}; }
-  std::span<const OverrunEvent> overruns() const noexcept { return {overruns_.data(), n_overruns_}; }
+  /// The overrun events kept (all of them with keep_records; else the first kMaxOverrunEvents).
+  std::span<const OverrunEvent> overruns() const noexcept {
+    return {overruns_.data(), n_overruns_ < overruns_.size() ? n_overruns_ : overruns_.size()};
+  }
   /// Statistics over the recorded steps [µs]: TET, wake-up latency, I/O time, and the cycle
   /// (I/O + TET: what the deadline is checked against, wake-up latency excluded).
   Summary tet_us() const { return rt::tet_us(records()); }
@@ -179,7 +225,7 @@ class PeriodicLoop {
   std::vector<StepRecord> records_;
   std::vector<OverrunEvent> overruns_;
   std::size_t n_records_ = 0;
-  std::size_t n_overruns_ = 0;
+  std::size_t n_overruns_ = 0;  ///< all overruns (the first overruns_.size() are kept)
 };
 
 }  // namespace lash::rt

@@ -1,0 +1,82 @@
+#include "lash/hil/sim_run.hpp"
+
+#include <cmath>
+#include <deque>
+
+#include "lash/io/atomic_file.hpp"
+#include "lash/io/csv.hpp"
+
+namespace lash::hil {
+
+SimulationFileRun simulate_to_csv(const BenchLayout& layout, const MasterConfig& master, const SlaveConfig& slave,
+                                  const FrameSchedule& schedule, double dt_s, const std::filesystem::path& out,
+                                  const BenchScenario* scenario, const std::vector<MasterStepLog>* compare_with) {
+  SimulationFileRun run;
+  AtomicFile f(out);
+  f.stream() << "control_step,t_s,reference_kPa,measured_kPa,current_mA,pressure_kPa\n";
+  StepResponseStream step(dt_s);
+  SimulationDiff diff;
+  std::vector<MasterStepLog> scenario_master;  // scenario figures only
+  std::vector<SlaveStepLog> scenario_slave;
+  // Control step m pairs with slave step m; either may come first.
+  std::deque<MasterStepLog> masters;
+  std::deque<SlaveStepLog> slaves;
+  std::string line;
+  auto emit = [&] {
+    while (!masters.empty() && !slaves.empty()) {
+      const MasterStepLog& ml = masters.front();
+      const SlaveStepLog& sl = slaves.front();
+      const auto m = static_cast<double>(run.rows);
+      line.clear();
+      append_double(line, static_cast<double>(ml.control_step));
+      line += ',';
+      append_double(line, m * dt_s);
+      for (double v : {ml.reference_kPa, ml.measured_kPa, ml.current_mA, sl.pressure_kPa}) {
+        line += ',';
+        append_double(line, v);
+      }
+      line += '\n';
+      f.stream() << line;
+      if (!scenario) step.add(ml.reference_kPa, sl.pressure_kPa);
+      ++run.rows;
+      masters.pop_front();
+      slaves.pop_front();
+    }
+  };
+  SimulationSink sink;
+  sink.master = [&](const MasterStepLog& l) {
+    if (scenario) scenario_master.push_back(l);
+    if (l.control_step < 0) return;
+    if (compare_with) {  // compare_with_simulation(), one simulated row at a time
+      const auto m = static_cast<std::size_t>(l.control_step);
+      if (m < compare_with->size() && (*compare_with)[m].control_step == l.control_step) {
+        const MasterStepLog& e = (*compare_with)[m];
+        ++diff.compared;
+        const double dp = std::abs(e.measured_kPa - l.measured_kPa);
+        const double di = std::abs(e.current_mA - l.current_mA);
+        if ((dp > 0 || di > 0) && !diff.first_diff_step) diff.first_diff_step = l.control_step;
+        diff.max_abs_diff_kPa = std::max(diff.max_abs_diff_kPa, dp);
+        diff.max_abs_diff_mA = std::max(diff.max_abs_diff_mA, di);
+      }
+    }
+    masters.push_back(l);
+    emit();
+  };
+  sink.slave = [&](const SlaveStepLog& l) {
+    if (scenario) scenario_slave.push_back(l);
+    slaves.push_back(l);
+    emit();
+  };
+  const SimulationResult r = simulate_bench(layout, master, slave, schedule, sink);
+  f.commit();
+  run.compensation = r.compensation;
+  if (compare_with) run.vs_log = diff;
+  if (scenario) {
+    run.scenario = scenario_figures(*scenario, dt_s, scenario_master, scenario_slave, r.compensation);
+  } else {
+    run.step = step.result();
+  }
+  return run;
+}
+
+}  // namespace lash::hil
