@@ -33,8 +33,9 @@ int run_closed_loop_scenario_cmd(const std::string& path, const std::string& com
     check_output_path(plot, "--plot");
   }
   try {
-    require_memory(experiments::scenario_memory_bytes(s), fmt::format("{}: duration_s = {} s at dt_s = {} s", path,
-                                                                      format_double(s.duration_s), format_double(s.dt_s)));
+    require_memory(experiments::scenario_memory_bytes(s),
+                   fmt::format("duration_s = {} s at dt_s = {} s (the bench simulation's logs, at least)",
+                               format_double(s.duration_s), format_double(s.dt_s)));
   } catch (const std::invalid_argument& e) {
     throw InputError(path, 0, "duration_s", e.what());
   }

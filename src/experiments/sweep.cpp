@@ -223,6 +223,13 @@ RunResult run_one(const Campaign& c, const RunSpec& r, const TraceFn& trace) {
   return out;
 }
 
+double campaign_memory_bytes(const Campaign& c, unsigned jobs) {
+  if (!c.estimator_from_data) return 0.0;
+  if (jobs == 0) jobs = std::max(1u, std::thread::hardware_concurrency());
+  const double workers = static_cast<double>(std::min<std::size_t>(jobs, std::max<std::size_t>(c.runs.size(), 1)));
+  return 60.0 * std::round(c.duration_s / c.dt_s) * workers;
+}
+
 std::vector<RunResult> run_campaign(const Campaign& c, unsigned jobs, const ProgressFn& progress) {
   const std::size_t total = c.runs.size();
   std::vector<RunResult> results(total);
