@@ -130,7 +130,7 @@ int run(const Options& o) {
   } catch (const std::invalid_argument& e) {
     throw InputError("", 0, "plant option", e.what());
   }
-  // 3600 s at the controller period bounds the trace (3.6e6 samples at 1 ms, ~0.2 GB at most).
+  // At most an hour each: the trace is streamed (memory O(1)), the limit keeps a typo from running for days.
   for (const auto& [name, v] : {std::pair{"--settle", o.settle}, std::pair{"--after", o.after}})
     if (!(v > 0) || !(v <= 3600.0)) throw InputError("", 0, name, "must be in (0, 3600] [s]");
   StepTest st{o.r0, o.r1, o.settle, o.after};
