@@ -1,12 +1,15 @@
 // lash closed-loop: the closed loop of docs/method.md §B2 (PID + deadzone inverse + saturation around the
 // pilot valve of §B1) simulated (a) discretely and (b) continuously with ode3; step metrics of both.
 #include <cmath>
+#include <optional>
+#include <tuple>
 #include <utility>
 
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
 #include "cli_common.hpp"
+#include "csv_stream.hpp"
 #include "controller_options.hpp"
 #include "plot.hpp"
 #include "lash/control/closed_loop.hpp"
@@ -30,10 +33,40 @@ struct Options {
   std::vector<ControllerOverride> controller;  // --kp, --ki-per-s, … (after the gains file)
 };
 
-nlohmann::json metrics_json(const StepMetrics& m) {
-  auto num = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
-  return {{"rise_s", num(m.rise_s)}, {"settling_s", num(m.settling_s)}, {"overshoot_pct", num(m.overshoot_pct)}};
+// Why a figure is not a number, in words (docs/control.md, "Figures that are not numbers").
+std::string reason_text(FigureStatus st, const StepMetrics& m, const char* what) {
+  switch (st) {
+    case FigureStatus::ok: return "";
+    case FigureStatus::not_reached:
+      return fmt::format("not_reached: the {} never reached 90 % of the step in the {:.6g} s after it", what,
+                         m.record_s);
+    case FigureStatus::not_settled:
+      return fmt::format("not_settled: the {} was still outside +-10 % of the step at the end of the record, {:.6g} s after it",
+                         what, m.record_s);
+    case FigureStatus::not_finite:
+      return fmt::format("not_finite: the {} was not a finite number on {} of {} samples from t = {:.6g} s (the simulation "
+                         "diverged)",
+                         what, m.nonfinite, m.samples, m.first_nonfinite_s);
+  }
+  return "";
 }
+
+nlohmann::json metrics_json(const StepMetrics& m, const char* what = "pressure") {
+  nlohmann::json j;
+  for (auto [key, x, st] : {std::tuple{"rise_s", m.rise_s, m.rise_status}, std::tuple{"settling_s", m.settling_s, m.settling_status},
+                            std::tuple{"overshoot_pct", m.overshoot_pct, m.overshoot_status}}) {
+    j[key] = std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
+    if (!std::isfinite(x)) j[std::string(key) + "_reason"] = reason_text(st, m, what);
+  }
+  return j;
+}
+
+// A figure for the text table: the number, or why there is none.
+std::string cell(double x, FigureStatus st, int decimals) {
+  return std::isfinite(x) ? fmt::format("{:.{}f}", x, decimals) : std::string(to_string(st));
+}
+
+bool diverged(const StepMetrics& m) { return m.nonfinite > 0; }
 
 // Beyond the thesis: thesis gains vs gains + deadzone inverse from the online RLS estimate,
 // on the virtual pilot-valve rig and on the B1 model with a second pole (tau2, default 8 ms).
@@ -67,7 +100,8 @@ int run_online(const Options& o, const ControllerConfig& thesis, const StepTest&
   fmt::print("{:<22} {:>12} {:>14} {:>14}\n", "plant / controller", "rise90 [s]", "settle10 [s]", "overshoot [%]");
   for (auto [name, mm] : {std::pair{"rig / thesis", th_rig}, std::pair{"rig / online", on_rig},
                           std::pair{"B1+pole / thesis", th_b1}, std::pair{"B1+pole / online", on_b1}})
-    fmt::print("{:<22} {:>12.4f} {:>14.4f} {:>14.2f}\n", name, mm.rise_s, mm.settling_s, mm.overshoot_pct);
+    fmt::print("{:<22} {:>12} {:>14} {:>14}\n", name, cell(mm.rise_s, mm.rise_status, 4),
+               cell(mm.settling_s, mm.settling_status, 4), cell(mm.overshoot_pct, mm.overshoot_status, 2));
   return kExitOk;
 }
 
@@ -96,22 +130,38 @@ int run(const Options& o) {
   } catch (const std::invalid_argument& e) {
     throw InputError("", 0, "plant option", e.what());
   }
-  // 3600 s at the controller period bounds the trace (3.6e6 samples at 1 ms, ~0.2 GB at most).
+  // At most an hour each: the trace is streamed (memory O(1)), the limit keeps a typo from running for days.
   for (const auto& [name, v] : {std::pair{"--settle", o.settle}, std::pair{"--after", o.after}})
     if (!(v > 0) || !(v <= 3600.0)) throw InputError("", 0, name, "must be in (0, 3600] [s]");
   StepTest st{o.r0, o.r1, o.settle, o.after};
   if (o.online) return run_online(o, c, st);
-  const StepResult d = run_step_test(Solver::discrete, p, c, st, o.bus_delay);
-  const StepResult c3 = run_step_test(Solver::ode3, p, c, st);
-  const double ratio = c3.metrics.overshoot_pct > 0 ? d.metrics.overshoot_pct / c3.metrics.overshoot_pct : NAN;
-  if (!o.out.empty()) {
-    const auto& a = d.trace;
-    const auto& b = c3.trace;
-    write_columns_csv(o.out,
-                      {"t", "reference_kPa", "discrete_measured_kPa", "discrete_pressure_kPa", "discrete_command_mA",
-                       "ode3_measured_kPa", "ode3_pressure_kPa", "ode3_command_mA"},
-                      {&a.t_s, &a.reference_kPa, &a.measured_kPa, &a.pressure_kPa, &a.command_mA, &b.measured_kPa,
-                       &b.pressure_kPa, &b.command_mA});
+  if (!o.plot.empty() && o.out.empty()) throw InputError("", 0, "--plot", "needs -o FILE (the plot is drawn from it)");
+  if (!o.out.empty()) check_output_path(o.out, "--output");
+  if (!o.plot.empty()) check_output_path(o.plot, "--plot");
+  try {
+    check_step_comparison(p, c, st);
+  } catch (const std::invalid_argument& e) {
+    throw InputError("", 0, "", e.what());
+  }
+  // Both loops in lockstep; the trace goes to the file row by row, the figures are computed as
+  // the samples come: memory O(1) in the test's length (plus the --bus-delay line).
+  std::optional<CsvStream> csv;
+  if (!o.out.empty())
+    csv.emplace(o.out, std::vector<std::string>{"t", "reference_kPa", "discrete_measured_kPa", "discrete_pressure_kPa",
+                                                "discrete_command_mA", "ode3_measured_kPa", "ode3_pressure_kPa",
+                                                "ode3_command_mA"});
+  StepRowFn row;
+  if (csv)
+    row = [&csv](const ClosedLoopSample& a, const ClosedLoopSample& b) {
+      const double v[8] = {a.t_s, a.reference_kPa, a.measured_kPa, a.pressure_kPa, a.command_mA, b.measured_kPa,
+                           b.pressure_kPa, b.command_mA};
+      csv->row(v);
+    };
+  const StepComparison r = run_step_comparison(p, c, st, o.bus_delay, row);
+  const StepFigures& d = r.discrete;
+  const StepFigures& c3 = r.ode3;
+  if (csv) {
+    csv->commit();
     if (!o.plot.empty())
       plot_csv(o.out, o.plot, "lash closed-loop: discrete vs ode3", {{"pressure [kPa]", "t [s]"}, {"current [mA]", "t [s]"}},
                {{"t", "reference_kPa", "reference", 0},
@@ -120,24 +170,51 @@ int run(const Options& o) {
                 {"t", "discrete_command_mA", "discrete", 1},
                 {"t", "ode3_command_mA", "ode3", 1}});
   }
+  const double ratio = c3.metrics.overshoot_pct > 0 ? d.metrics.overshoot_pct / c3.metrics.overshoot_pct : NAN;
+  std::string ratio_reason;
+  if (!std::isfinite(ratio))
+    ratio_reason = diverged(d.metrics) || diverged(c3.metrics)
+                       ? "not_finite: a simulation diverged"
+                       : "undefined: the ode3 loop does not overshoot (0 %)";
+  const bool failed = diverged(d.metrics) || diverged(c3.metrics) || diverged(d.measured_metrics) ||
+                      diverged(c3.measured_metrics) || d.nonfinite_commands > 0 || c3.nonfinite_commands > 0;
   if (o.json) {
     nlohmann::json j;
     j["gains"] = {{"kp", c.pid.gains.kp}, {"ki", c.pid.gains.ki_per_s}, {"kd", c.pid.gains.kd_s},
                   {"n", c.pid.gains.n_per_s}, {"dt_s", c.pid.dt_s}};
     j["step"] = {{"r0_kPa", o.r0}, {"r1_kPa", o.r1}};
+    j["samples"] = d.samples;
     j["discrete"] = metrics_json(d.metrics);
     j["ode3"] = metrics_json(c3.metrics);
-    j["discrete_measured"] = metrics_json(d.measured_metrics);
-    j["ode3_measured"] = metrics_json(c3.measured_metrics);
+    j["discrete_measured"] = metrics_json(d.measured_metrics, "measured pressure");
+    j["ode3_measured"] = metrics_json(c3.measured_metrics, "measured pressure");
     j["overshoot_ratio_discrete_over_ode3"] = std::isfinite(ratio) ? nlohmann::json(ratio) : nlohmann::json(nullptr);
+    if (!ratio_reason.empty()) j["overshoot_ratio_discrete_over_ode3_reason"] = ratio_reason;
+    j["complete"] = !failed;
+    if (failed) j["reason"] = "not_finite: a simulation diverged (non-finite pressure or command); see the figures' reasons";
     fmt::print("{}\n", j.dump());
   } else {
     fmt::print("closed loop, step {} -> {} kPa, T = {} s, gains {}\n", format_double(o.r0), format_double(o.r1),
                format_double(c.pid.dt_s), gains_path);
     fmt::print("{:<10} {:>12} {:>14} {:>14}\n", "solver", "rise90 [s]", "settle10 [s]", "overshoot [%]");
     for (auto [name, m] : {std::pair{"discrete", d.metrics}, std::pair{"ode3", c3.metrics}})
-      fmt::print("{:<10} {:>12.4f} {:>14.4f} {:>14.2f}\n", name, m.rise_s, m.settling_s, m.overshoot_pct);
-    fmt::print("overshoot ratio discrete/ode3 = {:.3f} (thesis 59/32 = {:.3f})\n", ratio, 59.0 / 32.0);
+      fmt::print("{:<10} {:>12} {:>14} {:>14}\n", name, cell(m.rise_s, m.rise_status, 4),
+                 cell(m.settling_s, m.settling_status, 4), cell(m.overshoot_pct, m.overshoot_status, 2));
+    if (std::isfinite(ratio))
+      fmt::print("overshoot ratio discrete/ode3 = {:.3f} (thesis 59/32 = {:.3f})\n", ratio, 59.0 / 32.0);
+    else
+      fmt::print("overshoot ratio discrete/ode3: {}\n", ratio_reason);
+    for (auto [name, m] : {std::pair{"discrete", d.metrics}, std::pair{"ode3", c3.metrics}})
+      for (auto [fig, status] : {std::pair{"rise90", m.rise_status}, std::pair{"settle10", m.settling_status},
+                             std::pair{"overshoot", m.overshoot_status}})
+        if (status != FigureStatus::ok) fmt::print("{} {}: {}\n", name, fig, reason_text(status, m, "pressure"));
+  }
+  if (failed) {
+    fmt::print(stderr,
+               "lash closed-loop: a simulation diverged (non-finite pressure on {} + {} samples, non-finite command on "
+               "{} + {} samples, discrete + ode3): its figures are not valid\n",
+               d.metrics.nonfinite, c3.metrics.nonfinite, d.nonfinite_commands, c3.nonfinite_commands);
+    return kExitFailed;
   }
   return kExitOk;
 }

@@ -1,11 +1,15 @@
 // lash closed-loop --scenario FILE.toml --compensation none|fixed|adaptive: a closed-loop
 // scenario with a drifting rig (lash/experiments/closed_loop_scenario.hpp); parse, call, print.
 #include <cmath>
+#include <optional>
+#include <span>
 
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
 #include "cli_common.hpp"
+#include "csv_stream.hpp"
+#include "lash/io/memory.hpp"
 #include "plot.hpp"
 #include "lash/experiments/closed_loop_scenario.hpp"
 
@@ -20,28 +24,51 @@ int run_closed_loop_scenario_cmd(const std::string& path, const std::string& com
     throw InputError("", 0, "--compensation", e.what());
   }
   const experiments::ClosedLoopScenario s = experiments::load_closed_loop_scenario(path);
-  const experiments::ClosedLoopScenarioResult r = experiments::run_closed_loop_scenario(s, mode);
   const bool valve = s.rig == rigs::RigKind::pilot_valve;
   const char* unit = valve ? "kPa" : "m";
   const char* punit = valve ? "mA" : "m";
+  if (!out.empty()) check_output_path(out, "--output");
+  if (!plot.empty()) {
+    if (out.empty()) throw InputError("", 0, "--plot", "needs -o FILE (the plot is drawn from it)");
+    check_output_path(plot, "--plot");
+  }
+  try {
+    require_memory(experiments::scenario_memory_bytes(s),
+                   fmt::format("duration_s = {} s at dt_s = {} s (the bench simulation's logs, at least)",
+                               format_double(s.duration_s), format_double(s.dt_s)));
+  } catch (const std::invalid_argument& e) {
+    throw InputError(path, 0, "duration_s", e.what());
+  }
+  const std::string y = valve ? "pressure_kPa" : "free_position_m";
+  const std::string ref = valve ? "reference_kPa" : "reference_m";
+  const std::string cmd = valve ? "current_mA" : "voltage_V";
+  const std::string pr = valve ? "edge_right_mA" : "deadband_right_m";
+  const std::string pl = valve ? "edge_left_mA" : "deadband_left_m";
+  // The trace goes to the file row by row as the run produces it; nothing is kept for it.
+  std::optional<CsvStream> csv;
+  experiments::ScenarioRowFn row;
   if (!out.empty()) {
-    const auto& tr = r.trace;
-    const std::string y = valve ? "pressure_kPa" : "free_position_m";
-    const std::string ref = valve ? "reference_kPa" : "reference_m";
-    const std::string cmd = valve ? "current_mA" : "voltage_V";
-    const std::string pr = valve ? "edge_right_mA" : "deadband_right_m";
-    const std::string pl = valve ? "edge_left_mA" : "deadband_left_m";
-    if (valve)
-      write_columns_csv(out, {"t", ref, y, cmd, pr, pl},
-                        {&tr.t_s, &tr.reference, &tr.output, &tr.command, &tr.param_right, &tr.param_left});
-    else
-      write_columns_csv(out, {"t", ref, y, cmd, pr, pl, "motor_position_m"},
-                        {&tr.t_s, &tr.reference, &tr.output, &tr.command, &tr.param_right, &tr.param_left, &tr.drive});
+    std::vector<std::string> names{"t", ref, y, cmd, pr, pl};
+    if (!valve) names.push_back("motor_position_m");
+    csv.emplace(out, names);
+    row = [&csv, valve](const experiments::ClosedLoopScenarioRow& r) {
+      const double v[7] = {r.t_s, r.reference, r.output, r.command, r.param_right, r.param_left, r.drive};
+      csv->row(std::span<const double>(v, valve ? 6 : 7));
+    };
+  }
+  const experiments::ClosedLoopScenarioResult r = experiments::run_closed_loop_scenario(s, mode, row);
+  if (csv) {
+    csv->commit();
     if (!plot.empty())
       plot_csv(out, plot, fmt::format("lash closed-loop {} ({})", path, compensation),
                {{fmt::format("output [{}]", unit), "t [s]"}, {fmt::format("inverse [{}]", punit), "t [s]"}},
                {{"t", ref, "reference", 0}, {"t", y, "output", 0}, {"t", pr, "right", 1}, {"t", pl, "left", 1}});
   }
+  // A figure that is not a number says why, and the run then did not produce what was asked.
+  const bool complete = std::isfinite(r.rms_error) && std::isfinite(r.max_abs_error) && std::isfinite(r.final_right) &&
+                        std::isfinite(r.final_left);
+  const std::string why =
+      complete ? "" : "not_finite: the closed loop's output or the inverse's parameters were not finite numbers (it diverged)";
   auto num = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
   if (json) {
     nlohmann::json j;
@@ -49,8 +76,11 @@ int run_closed_loop_scenario_cmd(const std::string& path, const std::string& com
     j["rig"] = rigs::to_string(s.rig);
     j["compensation_mode"] = to_string(mode);
     j["score_window_s"] = {s.score_t0_s, s.score_t1_s};
+    j["samples"] = r.samples;
     j["tracking"] = {{"rms_error", num(r.rms_error)}, {"max_abs_error", num(r.max_abs_error)}, {"unit", unit}};
-    j["compensation"] = {{"final", {{"right", r.final_right}, {"left", r.final_left}}}, {"unit", punit}};
+    j["compensation"] = {{"final", {{"right", num(r.final_right)}, {"left", num(r.final_left)}}}, {"unit", punit}};
+    j["complete"] = complete;
+    if (!complete) j["reason"] = why;
     j["adaptation"] = {{"updates", r.updates},
                        {"reason", to_string(r.reason)},
                        {"estimator_identified", r.estimator_identified},
@@ -71,7 +101,7 @@ int run_closed_loop_scenario_cmd(const std::string& path, const std::string& com
         if (b.contains(k)) j[k] = b[k];
     }
     fmt::print("{}\n", j.dump());
-    return kExitOk;
+    return complete ? kExitOk : kExitFailed;
   }
   fmt::print("scenario {} ({}), compensation {}\n", path, rigs::to_string(s.rig), to_string(mode));
   fmt::print("tracking over [{}, {}] s: rms error {:.6g} {}, max |error| {:.6g} {}\n", s.score_t0_s, s.score_t1_s,
@@ -80,6 +110,10 @@ int run_closed_loop_scenario_cmd(const std::string& path, const std::string& com
              r.final_left, punit, r.updates);
   if (mode == CompensationMode::adaptive)
     fmt::print("adaptation: {} (estimator: {})\n", to_string(r.reason), r.estimator_reason);
+  if (!complete) {
+    fmt::print("figures incomplete: {}\n", why);
+    return kExitFailed;
+  }
   return kExitOk;
 }
 

@@ -1,4 +1,5 @@
 // lash simulate: run a plant file open loop and write t,v,y,… as CSV.
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -6,6 +7,7 @@
 #include <fmt/core.h>
 
 #include "cli_common.hpp"
+#include "csv_stream.hpp"
 #include "plot.hpp"
 #include "lash/plant/plant_file.hpp"
 #include "lash/plant/simulate.hpp"
@@ -50,8 +52,72 @@ std::vector<StepLevel> parse_steps(const std::string& text) {
   return out;
 }
 
+// Every option checked before the first row: a value that makes a sample non-finite is refused
+// here, naming the option and its range (exit 2), never written as inf or nan.
+std::string g6(double x) { return fmt::format("{:.6g}", x); }
+
+void check_options(const SimulateOptions& o, const SimulationSpec& spec, const Plant& plant, std::size_t& n) {
+  auto finite = [](const char* name, double v, const char* unit) {
+    if (!std::isfinite(v)) throw InputError("", 0, name, fmt::format("must be a finite number [{}], got {}", unit, v));
+  };
+  finite("--amplitude", o.amplitude, "input unit");
+  finite("--offset", o.offset, "input unit");
+  finite("--phase", o.phase, "rad");
+  if (!(std::isfinite(o.frequency) && o.frequency >= 0))
+    throw InputError("", 0, "--frequency", fmt::format("must be a finite number >= 0 [rad/s], got {}", o.frequency));
+  if (spec.input.kind == Waveform::randomized) {
+    if (!(std::isfinite(o.variance) && o.variance >= 0))
+      throw InputError("", 0, "--variance", fmt::format("must be a finite number >= 0 [input unit^2], got {}", o.variance));
+    if (!(std::isfinite(o.tau) && o.tau > 0))
+      throw InputError("", 0, "--tau", fmt::format("must be a finite number > 0 [s], got {}", o.tau));
+  }
+  if (!(std::isfinite(o.noise_variance) && o.noise_variance >= 0))
+    throw InputError("", 0, "--noise-variance", fmt::format("must be a finite number >= 0 [y unit^2], got {}", o.noise_variance));
+  if (!(std::isfinite(o.duration) && o.duration > 0))
+    throw InputError("", 0, "--duration", fmt::format("must be a finite number > 0 [s], got {}", o.duration));
+  try {
+    n = sample_count(o.duration, plant.dt_s());
+  } catch (const std::invalid_argument& e) {
+    throw InputError("", 0, "--duration", fmt::format("{} s at dt = {} s: {} (at most 1e9 samples)", format_double(o.duration),
+                                                      format_double(plant.dt_s()), e.what()));
+  }
+  // The plant's worst case over n samples (plant/simulate.hpp): the input must keep it below 1e300.
+  const double limit = max_input_magnitude(plant, n);
+  const double need = max_abs_value(spec.input);
+  if (need <= limit) return;
+  const OutputBound b = output_bound(plant, n);
+  const std::string why =
+      fmt::format("this plant's output over {} samples can reach {}*max|v| + {} (docs/simulate.md), which must stay "
+                  "within 1e300",
+                  n, g6(b.gain), g6(b.offset));
+  if (!(limit > 0))
+    throw InputError(o.plant, 0, "blocks",
+                     fmt::format("no input is safe: {}; shorten --duration or use a stable plant", why));
+  const double off = std::fabs(o.offset);
+  if (!(off <= limit))
+    throw InputError("", 0, "--offset", fmt::format("|offset| must be at most {} [input unit]: {}; got {}",
+                                                    g6(limit), why, g6(o.offset)));
+  switch (spec.input.kind) {
+    case Waveform::steps:
+      throw InputError("", 0, "--steps", fmt::format("every |VALUE| + |offset| must be at most {} [input unit]: {}",
+                                                     g6(limit), why));
+    case Waveform::randomized: {
+      const double s = (limit - off) / 12.1;
+      throw InputError("", 0, "--variance",
+                       fmt::format("must be at most {} [input unit^2] (12.1 sigma + |offset| within {}): {}; got {}",
+                                   g6(s * s), g6(limit), why, g6(o.variance)));
+    }
+    default:
+      throw InputError("", 0, "--amplitude", fmt::format("|amplitude| + |offset| must be at most {} [input unit]: {}; got {}",
+                                                         g6(limit), why, g6(o.amplitude)));
+  }
+}
+
 int run(const SimulateOptions& o) {
-  if (o.dt && !(*o.dt > 0)) throw InputError("", 0, "--dt", "sample period must be > 0 [s]");
+  if (o.dt && !(*o.dt > 0 && std::isfinite(*o.dt)))
+    throw InputError("", 0, "--dt", "sample period must be a finite number > 0 [s]");
+  check_output_path(o.out, "--output");
+  if (!o.plot.empty()) check_output_path(o.plot, "--plot");
   Plant plant = load_plant(o.plant, o.dt.value_or(0.0));
   SimulationSpec spec;
   try {
@@ -68,24 +134,28 @@ int run(const SimulateOptions& o) {
   if (spec.input.kind == Waveform::steps) {
     if (o.steps.empty()) throw InputError("", 0, "--steps", "the steps input needs --steps TIME:VALUE,…");
     spec.input.steps = parse_steps(o.steps);
+    try {
+      Signal check(spec.input, plant.dt_s());
+    } catch (const std::invalid_argument& e) {
+      throw InputError("", 0, "--steps", e.what());
+    }
   }
   spec.duration_s = o.duration;
   spec.noise_variance = o.noise_variance;
   spec.seed = o.seed;
-  if (!(o.noise_variance >= 0)) throw InputError("", 0, "--noise-variance", "must be >= 0");
-  if (!(o.duration > 0)) throw InputError("", 0, "--duration", "must be > 0 [s]");
-  SimulationTrace tr = simulate(plant, spec);
+  std::size_t n = 0;
+  check_options(o, spec, plant, n);
 
-  std::vector<const std::vector<double>*> cols;
-  for (const auto& c : tr.cols) cols.push_back(&c);
-  write_columns_csv(o.out, tr.names, cols);
+  // Rows go to the file as they are produced: memory O(1) in the duration.
+  CsvStream csv(o.out, simulation_columns(plant));
+  simulate_rows(plant, spec, [&](std::span<const double> row) { csv.row(row); });
+  csv.commit();
   if (!o.plot.empty()) {
     plot_csv(o.out, o.plot, "lash simulate " + std::filesystem::path(o.plant).filename().string(),
              {{"input v", "t [s]"}, {"output y", "t [s]"}},
              {{"t", "v", "v", 0}, {"t", "y", "y", 1}});
   }
-  fmt::print(stderr, "lash simulate: {} samples at dt = {} s -> {}\n", tr.samples(), format_double(plant.dt_s()),
-             o.out);
+  fmt::print(stderr, "lash simulate: {} samples at dt = {} s -> {}\n", csv.rows(), format_double(plant.dt_s()), o.out);
   return kExitOk;
 }
 

@@ -10,7 +10,9 @@
 #include <fmt/core.h>
 
 #include "cli_common.hpp"
+#include "csv_stream.hpp"
 #include "lash/io/atomic_file.hpp"
+#include "lash/io/memory.hpp"
 #include "plot.hpp"
 #include "lash/experiments/campaign.hpp"
 #include "lash/experiments/sweep.hpp"
@@ -42,18 +44,14 @@ void write_trace(const sweep::Campaign& c, const std::vector<std::string>& arg) 
   if (idx >= c.runs.size())
     throw InputError("", 0, "--trace",
                      fmt::format("run {} does not exist: the campaign has runs 0..{}", idx, c.runs.size() - 1));
-  std::vector<sweep::TraceRow> rows;
-  sweep::run_one(c, c.runs[idx], &rows);
-  std::vector<std::vector<double>> cols(10);
-  for (auto& col : cols) col.reserve(rows.size());
-  for (const auto& r : rows) {
+  // Rows go to the file as the run produces them: memory O(1) in the run's length.
+  CsvStream csv(arg[1], {"t_s", "v", "y", "y_sim", "a1_r", "b1_r", "c_r", "a1_l", "b1_l", "c_l"});
+  sweep::run_one(c, c.runs[idx], [&csv](const sweep::TraceRow& r) {
     const double vals[10] = {r.t_s,           r.v,           r.y,           r.y_sim,       r.side.right.a1,
                              r.side.right.b1, r.side.right.c, r.side.left.a1, r.side.left.b1, r.side.left.c};
-    for (std::size_t i = 0; i < 10; ++i) cols[i].push_back(vals[i]);
-  }
-  std::vector<const std::vector<double>*> ptrs;
-  for (const auto& col : cols) ptrs.push_back(&col);
-  write_columns_csv(arg[1], {"t_s", "v", "y", "y_sim", "a1_r", "b1_r", "c_r", "a1_l", "b1_l", "c_l"}, ptrs);
+    csv.row(vals);
+  });
+  csv.commit();
 }
 
 /// Progress bar on stderr: runs done/total, elapsed, ETA. Redrawn in place on a terminal,
@@ -138,6 +136,14 @@ int run(const SweepOptions& o) {
   check_output_path(o.out, "--output");
   if (!o.plot.empty()) check_output_path(o.plot, "--plot");
   if (!o.trace.empty()) check_output_path(o.trace[1], "--trace");
+  try {
+    require_memory(sweep::campaign_memory_bytes(c, o.jobs),
+                   fmt::format("the settings analysis of {} (no [estimator] table: each worker keeps its run's "
+                               "record, ~60 bytes a sample)",
+                               o.campaign));
+  } catch (const std::invalid_argument& e) {
+    throw InputError(o.campaign, 0, "--jobs", e.what());
+  }
   if (!o.trace.empty()) {
     write_trace(c, o.trace);
     if (!o.quiet) fmt::print(stderr, "trace of run {} -> {}\n", o.trace[0], o.trace[1]);

@@ -9,6 +9,7 @@
 #include "lash/hil/schedule.hpp"
 #include "lash/identify/config_file.hpp"
 #include "lash/io/error.hpp"
+#include "lash/io/memory.hpp"
 #include "lash/io/toml_util.hpp"
 #include "lash/rigs/coupled_carts.hpp"
 #include "lash/rigs/pilot_valve_rig.hpp"
@@ -231,6 +232,12 @@ ClosedLoopScenario load_closed_loop_scenario(const std::filesystem::path& path) 
   s.score_t1_s = w[1];
   if (!(0 <= s.score_t0_s && s.score_t0_s < s.score_t1_s && s.score_t1_s <= s.duration_s))
     t.fail("score_window_s", "must satisfy 0 <= t0 < t1 <= duration_s = " + std::to_string(s.duration_s) + " s");
+  {
+    // At least one sample k·dt_s inside the window, or the tracking figures have nothing to score.
+    const double k0 = std::ceil(s.score_t0_s / s.dt_s - 1e-9), k1 = std::floor(s.score_t1_s / s.dt_s + 1e-9);
+    if (!(k0 <= k1))
+      t.fail("score_window_s", "holds no sample of dt_s = " + std::to_string(s.dt_s) + " s: widen it");
+  }
   t.finish();
   try {
     Pid check(s.pid);
@@ -249,18 +256,28 @@ namespace {
 double clamp(double x, double lo, double hi) noexcept { return x < lo ? lo : (x > hi ? hi : x); }
 
 
-void reserve(ClosedLoopScenarioTrace& tr, std::size_t n) {
-  for (auto* v : {&tr.t_s, &tr.reference, &tr.output, &tr.command, &tr.param_right, &tr.param_left}) v->reserve(n);
-}
-
-void record(ClosedLoopScenarioTrace& tr, double t, double r, double y, double cmd, double pr, double pl) {
-  tr.t_s.push_back(t);
-  tr.reference.push_back(r);
-  tr.output.push_back(y);
-  tr.command.push_back(cmd);
-  tr.param_right.push_back(pr);
-  tr.param_left.push_back(pl);
-}
+// RMS and max of r − y over a window, sample by sample: the arithmetic of hil::tracking (the same
+// bits), without keeping the samples.
+struct TrackingAccumulator {
+  double dt_s, t0_s, t1_s;
+  double sum2 = 0.0;
+  hil::Tracking w;
+  void add(std::size_t m, double r, double y) noexcept {
+    const double t = static_cast<double>(m) * dt_s;
+    if (t < t0_s - 1e-12 || t > t1_s + 1e-12) return;
+    const double e = r - y;
+    sum2 += e * e;
+    w.max_abs_error = std::max(w.max_abs_error, std::fabs(e));
+    ++w.samples;
+  }
+  hil::Tracking result() const {
+    hil::Tracking out = w;
+    out.t0_s = t0_s;
+    out.t1_s = t1_s;
+    out.rms_error = w.samples ? std::sqrt(sum2 / static_cast<double>(w.samples)) : std::nan("");
+    return out;
+  }
+};
 
 // The compensator's end state: the parameters in use, the updates and the verdict per side.
 template <class Comp>
@@ -311,12 +328,19 @@ void apply_to_bench(const ClosedLoopScenario& s, CompensationMode mode, hil::Ben
   b.scenario = std::move(h);
 }
 
-ClosedLoopScenarioResult run_closed_loop_scenario(const ClosedLoopScenario& s, CompensationMode mode) {
+double scenario_memory_bytes(const ClosedLoopScenario& s) {
+  if (s.rig != rigs::RigKind::pilot_valve) return 0.0;
+  const double n = std::round(s.duration_s / s.dt_s) + 1.0;
+  return n * static_cast<double>(sizeof(hil::MasterStepLog) + sizeof(hil::SlaveStepLog) + 2 * sizeof(hil::FrameUse));
+}
+
+ClosedLoopScenarioResult run_closed_loop_scenario(const ClosedLoopScenario& s, CompensationMode mode,
+                                                  const ScenarioRowFn& row) {
   ClosedLoopScenarioResult res;
   res.mode = mode;
   const double dt = s.dt_s;
   const auto n = static_cast<std::size_t>(step_of(s.duration_s, dt));
-  reserve(res.trace, n);
+  res.samples = n;
   Signal ref(s.reference, dt);
   Pid pid(s.pid);
   std::size_t next_drift = 0;
@@ -324,17 +348,21 @@ ClosedLoopScenarioResult run_closed_loop_scenario(const ClosedLoopScenario& s, C
     return next_drift < s.drift.size() && static_cast<std::int64_t>(k) >= step_of(s.drift[next_drift].at_s, dt);
   };
   if (s.rig == rigs::RigKind::pilot_valve) {
-    // One engine: the bench's nodes over the in-process link (what `lash hil run` runs).
+    // One engine: the bench's nodes over the in-process link (what `lash hil run` runs). Its
+    // logs are the bench's (hil); this runner keeps nothing of its own and streams the rows.
+    require_memory(scenario_memory_bytes(s),
+                   "a pilot_valve scenario of " + std::to_string(n) + " samples (the bench simulation's logs)");
     hil::BenchSettings b;
     apply_to_bench(s, mode, b);
     const hil::BenchLayout L;  // the layout of config/hydraulic_bench.dbc
     const hil::SimulationResult sim =
         hil::simulate_bench(L, hil::master_config(b, ""), hil::slave_config(b, L), hil::ideal_schedule(n));
-    for (std::size_t m = 0; m < n && m + 1 < sim.master.size() && m < sim.slave.size(); ++m) {
-      const auto& ml = sim.master[m + 1];  // master row 0 is the CONNECT step
-      record(res.trace, static_cast<double>(m) * dt, ml.reference_kPa, sim.slave[m].pressure_kPa, ml.current_mA,
-             ml.inverse_right_mA, ml.inverse_left_mA);
-    }
+    if (row)
+      for (std::size_t m = 0; m < n && m + 1 < sim.master.size() && m < sim.slave.size(); ++m) {
+        const auto& ml = sim.master[m + 1];  // master row 0 is the CONNECT step
+        row({static_cast<double>(m) * dt, ml.reference_kPa, sim.slave[m].pressure_kPa, ml.current_mA,
+             ml.inverse_right_mA, ml.inverse_left_mA, 0.0});
+      }
     res.bench = hil::scenario_figures(*b.scenario, dt, sim.master, sim.slave, sim.compensation);
     const hil::CompensationState& c = sim.compensation;
     res.rms_error = res.bench->window.rms_error;
@@ -346,43 +374,43 @@ ClosedLoopScenarioResult run_closed_loop_scenario(const ClosedLoopScenario& s, C
     res.estimator_identified = c.estimator_identified;
     res.estimator_reason = c.estimator_reason;
     return res;
-  } else {
-    BacklashCompensationConfig cc;
-    cc.mode = mode;
-    cc.nominal = s.backlash;
-    cc.estimator = s.backlash_estimator;
-    cc.adaptation = s.adaptation;
-    BacklashCompensator comp(cc);
-    rigs::CoupledCarts rig(s.rig_config.coupled_carts, dt, s.seed);
-    double y = rig.free_position_m(), w = rig.motor_position_m();
-    bool first = true;
-    double wstar1 = 0.0;
-    for (std::size_t k = 0; k < n; ++k) {
-      const double t = static_cast<double>(k) * dt;
-      while (drift_due(k)) rig.set_params(s.drift[next_drift++].after.coupled_carts);
-      const double r = ref.next();
-      if (first) {
-        comp.reset(r);
-        wstar1 = comp.command(r);
-        first = false;
-      }
-      const double wstar = comp.command(r);
-      const double ff = s.feedforward * (wstar - wstar1) / dt;  // velocity feedforward
-      wstar1 = wstar;
-      const double v = clamp(pid.step(wstar - w) + ff, s.command_min, s.command_max);
-      comp.observe(w, y, true);  // simulated: every sample fresh
-      const PerSide<double> used = comp.in_use();
-      record(res.trace, t, r, y, v, used.right, used.left);
-      res.trace.drive.push_back(w);
-      rig.step(v);
-      y = rig.free_position_m();
-      w = rig.motor_position_m();
-    }
-    finish(res, comp);
   }
-  const hil::Tracking w = hil::tracking(res.trace.reference, res.trace.output, dt, s.score_t0_s, s.score_t1_s);
-  res.rms_error = w.rms_error;
-  res.max_abs_error = w.max_abs_error;
+  BacklashCompensationConfig cc;
+  cc.mode = mode;
+  cc.nominal = s.backlash;
+  cc.estimator = s.backlash_estimator;
+  cc.adaptation = s.adaptation;
+  BacklashCompensator comp(cc);
+  rigs::CoupledCarts rig(s.rig_config.coupled_carts, dt, s.seed);
+  TrackingAccumulator track{dt, s.score_t0_s, s.score_t1_s, 0.0, {}};
+  double y = rig.free_position_m(), w = rig.motor_position_m();
+  bool first = true;
+  double wstar1 = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double t = static_cast<double>(k) * dt;
+    while (drift_due(k)) rig.set_params(s.drift[next_drift++].after.coupled_carts);
+    const double r = ref.next();
+    if (first) {
+      comp.reset(r);
+      wstar1 = comp.command(r);
+      first = false;
+    }
+    const double wstar = comp.command(r);
+    const double ff = s.feedforward * (wstar - wstar1) / dt;  // velocity feedforward
+    wstar1 = wstar;
+    const double v = clamp(pid.step(wstar - w) + ff, s.command_min, s.command_max);
+    comp.observe(w, y, true);  // simulated: every sample fresh
+    const PerSide<double> used = comp.in_use();
+    track.add(k, r, y);
+    if (row) row({t, r, y, v, used.right, used.left, w});
+    rig.step(v);
+    y = rig.free_position_m();
+    w = rig.motor_position_m();
+  }
+  finish(res, comp);
+  const hil::Tracking tw = track.result();
+  res.rms_error = tw.rms_error;
+  res.max_abs_error = tw.max_abs_error;
   return res;
 }
 

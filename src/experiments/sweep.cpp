@@ -81,9 +81,8 @@ void score_params(RunResult& out, bool compare_tau) {
 /// then the rig advances over [t_k, t_{k+1}] with v(k) held and returns y(k+1).
 template <class Est, class Rig, class Measure, class Simulated>
 void drive(Est& est, Rig& rig, Measure measure, Simulated simulated, Signal& sig, std::size_t n, Score& score,
-           double dt_s, std::vector<TraceRow>* trace) {
+           double dt_s, const TraceFn& trace) {
   auto y = rig.initial_output();
-  if (trace) trace->reserve(trace->size() + n);
   for (std::size_t k = 0; k < n; ++k) {
     const double v = sig.next();
     const auto [y_est, y_scored] = measure(y);
@@ -91,8 +90,8 @@ void drive(Est& est, Rig& rig, Measure measure, Simulated simulated, Signal& sig
     const double y_sim = simulated(est);
     score.add(k, y_scored, y_sim);
     if (trace)
-      trace->push_back(TraceRow{static_cast<double>(k) * dt_s, v, y_scored, y_sim,
-                                {est.params(Side::right), est.params(Side::left)}});
+      trace(TraceRow{static_cast<double>(k) * dt_s, v, y_scored, y_sim,
+                     {est.params(Side::right), est.params(Side::left)}});
     y = rig.step(v);
   }
 }
@@ -116,7 +115,7 @@ RunResult finish(const Campaign& c, const RunSpec& r, const Est& est, const Scor
 /// (load_campaign admits no other model for these rigs).
 template <class Rig>
 RunResult run_deadzone_model(const Campaign& c, const EstimatorConfig& ec, const RunSpec& r, Rig& rig, Signal& sig,
-                             std::size_t n, Score& score, std::vector<TraceRow>* trace) {
+                             std::size_t n, Score& score, const TraceFn& trace) {
   auto same = [](double y) { return std::pair<double, double>{y, y}; };
   if (ec.model == ModelKind::output_deadzone) {
     OutputDeadzoneEstimator est(ec);
@@ -173,7 +172,7 @@ EstimatorConfig settings_for(const Campaign& c, const RunSpec& r) {
 
 }  // namespace
 
-RunResult run_one(const Campaign& c, const RunSpec& r, std::vector<TraceRow>* trace) {
+RunResult run_one(const Campaign& c, const RunSpec& r, const TraceFn& trace) {
   Signal sig(signal_of(c, r), c.dt_s);
   const std::size_t n = sample_count(c.duration_s, c.dt_s);
   Score score;
@@ -222,6 +221,13 @@ RunResult run_one(const Campaign& c, const RunSpec& r, std::vector<TraceRow>* tr
     }
   }
   return out;
+}
+
+double campaign_memory_bytes(const Campaign& c, unsigned jobs) {
+  if (!c.estimator_from_data) return 0.0;
+  if (jobs == 0) jobs = std::max(1u, std::thread::hardware_concurrency());
+  const double workers = static_cast<double>(std::min<std::size_t>(jobs, std::max<std::size_t>(c.runs.size(), 1)));
+  return 60.0 * std::round(c.duration_s / c.dt_s) * workers;
 }
 
 std::vector<RunResult> run_campaign(const Campaign& c, unsigned jobs, const ProgressFn& progress) {

@@ -1,7 +1,11 @@
 #include "lash/plant/simulate.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
+#include <type_traits>
+#include <variant>
 
 #include <fmt/core.h>
 
@@ -38,6 +42,52 @@ SimulationTrace simulate(Plant& plant, const SimulationSpec& spec) {
   return simulate(plant, v, spec.noise_variance, spec.seed);
 }
 
+std::vector<std::string> simulation_columns(const Plant& plant) {
+  std::vector<std::string> names = {"t", "v", "y", "y_true"};
+  for (std::size_t i = 0; i < plant.blocks().size(); ++i)
+    names.push_back("x" + std::to_string(i + 1) + "_" + block_kind(plant.blocks()[i]));
+  return names;
+}
+
+namespace {
+
+// One sample into row[]: t, v, y (+ noise), y_true, the blocks' outputs.
+inline void step_row(Plant& plant, GaussianNoise& noise, std::size_t k, double v, double dt, double* row) {
+  const double y = plant.step(v);
+  // A finite input must give a finite output: an overflow (an amplitude of 1e308 through a
+  // gain) is refused, never written as inf (a non-finite input passes through as given).
+  if (!std::isfinite(y) && std::isfinite(v)) [[unlikely]]
+    throw std::invalid_argument(fmt::format("the plant's output overflows at sample {} (t = {} s) for the input {}: "
+                                            "reduce the input's amplitude or the plant's gains",
+                                            k, static_cast<double>(k) * dt, v));
+  row[0] = static_cast<double>(k) * dt;
+  row[1] = v;
+  row[2] = y + noise.step();
+  row[3] = y;
+  const auto s = plant.signals();
+  for (std::size_t i = 0; i < s.size(); ++i) row[4 + i] = s[i];
+}
+
+}  // namespace
+
+std::size_t simulate_rows(Plant& plant, const SimulationSpec& spec, const SimulationRowFn& row) {
+  if (!(std::isfinite(spec.noise_variance) && spec.noise_variance >= 0))
+    throw std::invalid_argument("noise variance must be >= 0");
+  const std::size_t n = sample_count(spec.duration_s, plant.dt_s());
+  SignalSpec in = spec.input;
+  in.seed = spec.seed;
+  Signal sig(in, plant.dt_s());
+  GaussianNoise noise(spec.noise_variance, noise_seed(spec.seed));
+  plant.reset();
+  std::vector<double> r(4 + plant.blocks().size());
+  const double dt = plant.dt_s();
+  for (std::size_t k = 0; k < n; ++k) {
+    step_row(plant, noise, k, sig.next(), dt, r.data());
+    row(r);
+  }
+  return n;
+}
+
 SimulationTrace simulate(Plant& plant, std::span<const double> v, double noise_variance, std::uint64_t seed) {
   if (!(std::isfinite(noise_variance) && noise_variance >= 0)) throw std::invalid_argument("noise variance must be >= 0");
   const double dt = plant.dt_s();
@@ -46,26 +96,72 @@ SimulationTrace simulate(Plant& plant, std::span<const double> v, double noise_v
   plant.reset();
 
   SimulationTrace tr;
-  tr.names = {"t", "v", "y", "y_true"};
-  for (std::size_t i = 0; i < plant.blocks().size(); ++i)
-    tr.names.push_back("x" + std::to_string(i + 1) + "_" + block_kind(plant.blocks()[i]));
+  tr.names = simulation_columns(plant);
   tr.cols.assign(tr.names.size(), std::vector<double>(n));
+  std::vector<double> r(tr.names.size());
   for (std::size_t k = 0; k < n; ++k) {
-    const double y = plant.step(v[k]);
-    // A finite input must give a finite output: an overflow (an amplitude of 1e308 through a
-    // gain) is refused, never written as inf (a non-finite input passes through as given).
-    if (!std::isfinite(y) && std::isfinite(v[k])) [[unlikely]]
-      throw std::invalid_argument(fmt::format("the plant's output overflows at sample {} (t = {} s) for the input {}: "
-                                              "reduce the input's amplitude or the plant's gains",
-                                              k, static_cast<double>(k) * dt, v[k]));
-    tr.cols[0][k] = static_cast<double>(k) * dt;
-    tr.cols[1][k] = v[k];
-    tr.cols[2][k] = y + noise.step();
-    tr.cols[3][k] = y;
-    const auto s = plant.signals();
-    for (std::size_t i = 0; i < s.size(); ++i) tr.cols[4 + i][k] = s[i];
+    step_row(plant, noise, k, v[k], dt, r.data());
+    for (std::size_t c = 0; c < r.size(); ++c) tr.cols[c][k] = r[c];
   }
   return tr;
+}
+
+namespace {
+
+struct Bound {
+  double gain, offset;
+};
+
+// Σ_{i<n} A^i: the largest amplification of a first-order lag |w(k)| ≤ A|w(k−1)| + B·max|u|.
+double geometric_sum(double A, std::size_t n) {
+  const double nd = static_cast<double>(n);
+  if (A == 1.0) return nd;
+  if (A < 1.0) return std::min(nd, (1.0 - std::pow(A, nd)) / (1.0 - A));
+  return (std::pow(A, nd) - 1.0) / (A - 1.0);  // may be inf
+}
+
+// a·g with 0·inf = 0 (a zero bound stays zero through any amplification).
+double mul(double a, double g) { return a == 0.0 || g == 0.0 ? 0.0 : a * g; }
+
+}  // namespace
+
+OutputBound output_bound(const Plant& plant, std::size_t n) {
+  Bound b{1.0, 0.0};
+  for (const Block& blk : plant.blocks()) {
+    std::visit(
+        [&](const auto& x) {
+          using T = std::decay_t<decltype(x)>;
+          if constexpr (std::is_same_v<T, Deadzone>) {
+            b.offset += std::max(std::fabs(x.params().left), std::fabs(x.params().right));
+          } else if constexpr (std::is_same_v<T, Deadband>) {
+            b.offset += std::max(std::fabs(x.half_width().left), std::fabs(x.half_width().right));
+          } else if constexpr (std::is_same_v<T, FirstOrder>) {
+            const auto& p = x.params();
+            const double A = std::max(std::fabs(p.left.a1), std::fabs(p.right.a1));
+            const double B = std::max(std::fabs(p.left.b1), std::fabs(p.right.b1));
+            const double g = B * geometric_sum(A, n);
+            b.gain = mul(b.gain, g);
+            b.offset = mul(b.offset, g);
+          } else if constexpr (std::is_same_v<T, BackwardDifference>) {
+            b.gain = mul(b.gain, 2.0 / x.dt_s());
+            b.offset = mul(b.offset, 2.0 / x.dt_s());
+          } else if constexpr (std::is_same_v<T, Saturation>) {
+            b.gain = 0.0;
+            b.offset = std::max(std::fabs(x.lower()), std::fabs(x.upper()));
+          }
+          // MovingAverage and Delay: |out| ≤ max|in|.
+        },
+        blk);
+  }
+  return {b.gain, b.offset};
+}
+
+double max_input_magnitude(const Plant& plant, std::size_t n) {
+  const OutputBound b = output_bound(plant, n);
+  if (!(b.offset <= kMaxSimulatedOutput)) return 0.0;
+  if (b.gain == 0.0) return std::numeric_limits<double>::infinity();
+  const double m = (kMaxSimulatedOutput - b.offset) / b.gain;
+  return std::isfinite(m) ? m : std::numeric_limits<double>::infinity();
 }
 
 }  // namespace lash

@@ -1,6 +1,8 @@
 #include "lash/signals/signal.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 
@@ -27,6 +29,23 @@ const char* to_string(Waveform w) noexcept {
     case Waveform::constant: return "constant";
   }
   return "?";
+}
+
+double max_abs_value(const SignalSpec& s) noexcept {
+  const double off = std::fabs(s.offset);
+  switch (s.kind) {
+    case Waveform::sine:
+    case Waveform::square:
+    case Waveform::triangle: return std::fabs(s.amplitude) + off;
+    case Waveform::constant: return std::fabs(s.amplitude + s.offset);
+    case Waveform::randomized: return off + 12.1 * std::sqrt(s.variance);
+    case Waveform::steps: {
+      double m = 0.0;
+      for (const auto& l : s.steps) m = std::isnan(l.value) ? l.value : std::max(m, std::fabs(l.value));
+      return m + off;
+    }
+  }
+  return std::numeric_limits<double>::quiet_NaN();
 }
 
 Signal::Signal(SignalSpec spec, double dt_s) : spec_(std::move(spec)), dt_s_(dt_s), rng_(spec_.seed) {

@@ -16,6 +16,7 @@
 /// The run loop calls only noexcept, allocation-free step functions per sample.
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -65,10 +66,14 @@ struct ClosedLoopScenario {
 /// Reads a scenario TOML (keys in docs/compensation.md). Throws InputError (file:line:key).
 ClosedLoopScenario load_closed_loop_scenario(const std::filesystem::path& path);
 
-struct ClosedLoopScenarioTrace {
-  std::vector<double> t_s, reference, output, command, param_right, param_left;
-  std::vector<double> drive;  ///< coupled carts: the motor cart's position w [m] (empty for the valve)
+/// One sample of a scenario run (a row of `lash closed-loop --scenario -o`).
+struct ClosedLoopScenarioRow {
+  double t_s = 0.0;
+  double reference = 0.0, output = 0.0, command = 0.0;  ///< r, y [rig output unit]; the rig input [mA or V]
+  double param_right = 0.0, param_left = 0.0;           ///< the inverse's parameters in use
+  double drive = 0.0;  ///< coupled carts: the motor cart's position w [m] (0 for the valve)
 };
+using ScenarioRowFn = std::function<void(const ClosedLoopScenarioRow&)>;
 
 struct ClosedLoopScenarioResult {
   CompensationMode mode = CompensationMode::none;
@@ -79,7 +84,7 @@ struct ClosedLoopScenarioResult {
   AdaptationReason reason = AdaptationReason::nominal;
   std::string estimator_reason;  ///< the estimator's side of the verdict
   bool estimator_identified = false;
-  ClosedLoopScenarioTrace trace;
+  std::size_t samples = 0;       ///< samples run
   /// pilot_valve: the bench's figures (tracking over the window and before/after the first drift).
   std::optional<hil::ScenarioFigures> bench;
 };
@@ -94,6 +99,17 @@ void apply_to_bench(const ClosedLoopScenario& s, CompensationMode mode, hil::Ben
 /// nodes (hil::simulate_bench with apply_to_bench's settings): the same step code, timing and
 /// bus quantisation as `lash hil run --scenario`, so the figures agree bit for bit. Throws std::invalid_argument on an invalid
 /// configuration (a scenario from load_closed_loop_scenario is valid).
-ClosedLoopScenarioResult run_closed_loop_scenario(const ClosedLoopScenario& s, CompensationMode mode);
+///
+/// The runner keeps no trace: `row` (when set) gets every sample as it is produced, and the
+/// tracking figures are accumulated on the way (O(1)). Memory: coupled carts O(1) in the
+/// duration; pilot valve: the bench simulation's node logs (hil::simulate_bench, docs/hil.md),
+/// checked against the machine's memory before the run (std::invalid_argument with the figure).
+ClosedLoopScenarioResult run_closed_loop_scenario(const ClosedLoopScenario& s, CompensationMode mode,
+                                                  const ScenarioRowFn& row = {});
+
+/// Bytes a run of `s` needs that grow with its duration, at least: 0 for the coupled carts; for
+/// the valve the bench simulation's logs, (sizeof master + slave log row + 2 schedule entries)
+/// per sample (a lower bound: measured ~1.1 kB a sample with the vectors' growth, docs/memory.md).
+double scenario_memory_bytes(const ClosedLoopScenario& s);
 
 }  // namespace lash::experiments

@@ -55,10 +55,21 @@ struct TraceRow {
   PerSide<SideParams> side;  ///< the estimator's parameters after the sample (NaN while not identified)
 };
 
+/// Receives every sample of a traced run as it is produced.
+using TraceFn = std::function<void(const TraceRow&)>;
+
 /// Runs one run from scratch (deterministic: same campaign and spec → same bits). With
-/// `trace`, every sample is appended to it (the NRMSE over the window is computed from
-/// exactly these y and y_sim).
-RunResult run_one(const Campaign& c, const RunSpec& run, std::vector<TraceRow>* trace = nullptr);
+/// `trace`, every sample is passed to it as it is produced and nothing is kept (the NRMSE over
+/// the window is computed from exactly these y and y_sim). Memory: O(1) in the run's length,
+/// except a campaign without an [estimator] table, whose settings are tuned to the run's record
+/// first (v and y of the run, 16 bytes a sample, freed before the run).
+RunResult run_one(const Campaign& c, const RunSpec& run, const TraceFn& trace = {});
+
+/// Memory that grows with a run's length, for `jobs` workers (0 = all cores), at least: a
+/// campaign without an [estimator] table keeps each worker's run record for the settings
+/// analysis, ~60 bytes a sample (16 of v and y, the rest identify's analysis; measured,
+/// docs/memory.md); 0 otherwise (the runs are O(1)).
+double campaign_memory_bytes(const Campaign& c, unsigned jobs);
 
 /// Called from the coordinating thread with (runs done, total) about five times a second
 /// and once at the end.

@@ -2,7 +2,10 @@
 /// @file simulate.hpp
 /// Open-loop simulation of a plant driven by a signal, with optional additive
 /// Gaussian measurement noise on y. Not real-time safe (allocates the trace).
+/// simulate_rows() keeps nothing: each sample goes to a callback as it is produced (memory
+/// O(1) in the duration), which is how `lash simulate` writes its CSV.
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
@@ -36,6 +39,37 @@ std::uint64_t noise_seed(std::uint64_t seed) noexcept;
 
 /// Runs the plant from its zero state (the plant is reset first).
 SimulationTrace simulate(Plant& plant, const SimulationSpec& spec);
+
+/// Names of the columns of a simulation of `plant`: t, v, y, y_true, x1_<kind>, …
+std::vector<std::string> simulation_columns(const Plant& plant);
+
+/// One row of a simulation, in the order of simulation_columns().
+using SimulationRowFn = std::function<void(std::span<const double> row)>;
+
+/// simulate(plant, spec) without a trace: `row` gets every sample as it is produced; returns
+/// the number of samples. Same bits as simulate(). Throws std::invalid_argument (before the first
+/// row) for an invalid spec, and, should the output still overflow, at that sample (no row
+/// holding inf or nan is ever passed on).
+std::size_t simulate_rows(Plant& plant, const SimulationSpec& spec, const SimulationRowFn& row);
+
+/// A worst-case bound of the plant's output over n samples: |y(k)| ≤ gain·max|v| + offset for
+/// every k < n, for any input v, propagated block by block (deadzone and deadband add their
+/// widths, a first-order lag multiplies by max|b1|·Σ max|a1|^i, a difference by 2/T, a
+/// saturation caps). gain may be inf (an unstable lag over many samples).
+struct OutputBound {
+  double gain = 1.0;
+  double offset = 0.0;
+  double at(double max_abs_input) const noexcept { return max_abs_input == 0.0 ? offset : gain * max_abs_input + offset; }
+};
+OutputBound output_bound(const Plant& plant, std::size_t n);
+
+/// The bound on |y| that `lash simulate` requires of its options [y unit]: 1e300 leaves a margin
+/// below DBL_MAX (1.8e308) for the added noise.
+inline constexpr double kMaxSimulatedOutput = 1e300;
+
+/// The largest max|v| for which output_bound(plant, n) stays ≤ kMaxSimulatedOutput (0 when even a
+/// zero input can exceed it, inf when any finite input is safe).
+double max_input_magnitude(const Plant& plant, std::size_t n);
 
 /// Runs the plant from its zero state over a given input v (one sample per step, t_k = k·T),
 /// adding Gaussian noise of `noise_variance` [y unit²] to y from noise_seed(seed).

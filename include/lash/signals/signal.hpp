@@ -36,6 +36,12 @@ struct SignalSpec {
   std::vector<StepLevel> steps;  ///< steps: levels in increasing time; 0 before the first
 };
 
+/// The largest |value| the signal can take (before any check of its parameters): sine, square,
+/// triangle |A| + |offset|; constant |A + offset|; steps max|value| + |offset|; randomized
+/// |offset| + 12.1·√variance (the polar method's |g| ≤ √(−2 ln s) ≤ 12.01 for its smallest
+/// s = 2⁻¹⁰⁴, and the low-pass is a convex combination). NaN when a parameter is NaN.
+double max_abs_value(const SignalSpec& spec) noexcept;
+
 /// Generates a signal sample by sample. Not copyable state is cheap; next() is noexcept O(1)
 /// (step sequences advance a cursor, so their cost is amortised O(1)).
 class Signal {
