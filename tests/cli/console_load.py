@@ -101,8 +101,10 @@ with tempfile.TemporaryDirectory() as tmp:
         redraws = (s1["draws"] - s0["draws"]) / 10.0
         fps = (s1["frames"] - s0["frames"]) / 10.0
         mb = (s1["bytes"] - s0["bytes"]) / 10.0 / 1e6
+        ms = (s1["renderMs"] - s0["renderMs"]) / max(1, s1["draws"] - s0["draws"])
         print(f"page over 10 s: {redraws:.1f} data redraws/s, {fps:.1f} requestAnimationFrame/s, {mb:.1f} MB/s of "
-              f"frames, stalls (> 100 ms between redraws) {s1['stalls'] - s0['stalls']}")
+              f"frames, stalls (> 100 ms between redraws) {s1['stalls'] - s0['stalls']}; main-thread time per "
+              f"redraw of the 32 signals {ms:.2f} ms")
         shown = d.execute_script("const q = (k) => { const e = document.querySelector(`[data-status=\"${k}\"]`);"
                                  " return e ? e.textContent : null; }; return [q('drops'), q('stalls')];")
         if any(x is None or not x.strip().isdigit() for x in shown):

@@ -79,12 +79,18 @@
       scales: { x: { time: false }, y: { range: yRange(p) } },
       axes: [{ label: "t [s]" }, {}],
       legend: { live: false, show: p.signals.length <= 8 },
-      hooks: { draw: [(u) => drawEnvelopes(u, p), (u) => drawEvents(u)] },
+      hooks: { draw: [(u) => drawEnvelopes(u, p), (u) => drawEvents(u), () => drawn()] },
     };
     p.plot = new uPlot(opts, [[]].concat(series.slice(1).map(() => [])), div);
     if (p.signals.length <= 8)  // one legend entry per signal: hide the "min" twins
       div.querySelectorAll(".u-legend .u-series").forEach((e, i) => { if (i % 2 === 1) e.style.display = "none"; });
     panels.push(p);
+  }
+
+  // the page's main-thread time per redraw: from render() to the last scope drawn [ms]
+  let renderStart = 0, pending = 0;
+  function drawn() {
+    if (pending > 0 && --pending === 0) window.lashStats.renderMs += performance.now() - renderStart;
   }
 
   function drawEnvelopes(u, p) {
@@ -164,7 +170,8 @@
   }
 
   function render() {
-    const tr0 = performance.now();
+    renderStart = performance.now();
+    pending = panels.length;
     const f = frame;
     for (const p of panels) {
       const cols = [f.t];
@@ -180,7 +187,6 @@
       p.plot.setScale("x", { min: x0, max: f.t_end });
     }
     const now = performance.now();
-    window.lashStats.renderMs += now - tr0;
     if (lastDraw && now - lastDraw > 100) { stalls++; window.lashStats.stalls = stalls; }
     lastDraw = now;
     draws++;
