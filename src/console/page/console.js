@@ -77,7 +77,7 @@
     const opts = {
       width: Math.max(300, $("scopes").clientWidth - 20), height: p.signals.length > 4 ? 170 : 150, series,
       scales: { x: { time: false }, y: { range: yRange(p) } },
-      axes: [{ label: "t [s]" }, {}],
+      axes: [{ label: "t [s]" }, { size: 64 }],
       legend: { live: false, show: p.signals.length <= 8 },
       hooks: { draw: [(u) => drawEnvelopes(u, p), (u) => drawEvents(u), () => drawn()] },
     };
@@ -136,7 +136,7 @@
       { label: name + " (not identified)", stroke: VERDICT.no, width: 1, dash: [4, 3], points: { show: true, size: 4 } }];
     const opts = { width: Math.max(300, $("scopes").clientWidth - 20), height: 150, series,
       bands: [{ series: [1, 2], fill: "#90a4ae44" }],
-      scales: { x: { time: false }, y: { range: yRange(p) } }, axes: [{ label: "t [s]" }, {}],
+      scales: { x: { time: false }, y: { range: yRange(p) } }, axes: [{ label: "t [s]" }, { size: 64 }],
       hooks: { draw: [(u) => drawEvents(u)] } };
     p.plot = new uPlot(opts, [[], [], [], [], []], div);
     estPanels.set(name, p);
@@ -232,7 +232,8 @@
 
   function fmt(v) { return typeof v === "number" ? (Math.abs(v) >= 1000 || Number.isInteger(v) ? v.toFixed(0) : v.toPrecision(4)) : String(v); }
 
-  const BAD = /gaps|incomplete|overrun|lost|late|stall|drops/;
+  // counters whose non-zero value is shown in red
+  const BAD = /^(drops|stalls|daq_gaps|daq_incomplete|overruns|frames_late|frames_lost|frames_dropped|counter_jumps|stale_silences)$/;
   function showStatus(d) {
     const f = frame;
     const rows = [["drops", d.drops, "samples the console's ring refused (its drain fell behind)"],
