@@ -104,22 +104,33 @@
     ctx.beginPath();
     ctx.rect(u.bbox.left, top, u.bbox.width, u.bbox.height);
     ctx.clip();
+    // one polygon per run of non-empty columns: along the maxima (each column's top edge from its
+    // left to its right pixel), back along the minima; adjacent columns join, a spike is kept
+    const up = new Float64Array(2 * n), dn = new Float64Array(2 * n);
     for (let k = 0; k < p.idx.length; k++) {
       const hi = d[1 + 2 * k], lo = d[2 + 2 * k];
       if (!u.series[1 + 2 * k].show) continue;
       ctx.fillStyle = p.colors[k];
+      ctx.strokeStyle = p.colors[k];
+      ctx.lineWidth = 1;
       ctx.beginPath();
-      let pl = null, ph = null;
-      for (let c = 0; c < n; c++) {
-        let a = lo[c], b = hi[c];
-        if (a == null || b == null) { pl = ph = null; continue; }
-        if (pl !== null) { if (a > ph) a = ph; if (b < pl) b = pl; }  // join to the previous column
-        pl = lo[c]; ph = hi[c];
-        const y0 = Math.min(bottom, Math.max(top, u.valToPos(b, "y", true)));
-        const y1 = Math.min(bottom, Math.max(top, u.valToPos(a, "y", true)));
-        ctx.rect(px[c], y0, Math.max(1, px[c + 1] - px[c]), Math.max(1, y1 - y0));
+      let c = 0;
+      while (c < n) {
+        while (c < n && (hi[c] == null || lo[c] == null)) c++;
+        const c0 = c;
+        while (c < n && hi[c] != null && lo[c] != null) {
+          up[c] = u.valToPos(hi[c], "y", true);
+          dn[c] = u.valToPos(lo[c], "y", true);
+          c++;
+        }
+        if (c === c0) break;
+        ctx.moveTo(px[c0], up[c0]);
+        for (let j = c0; j < c; j++) { ctx.lineTo(px[j], up[j]); ctx.lineTo(px[j + 1], up[j]); }
+        for (let j = c - 1; j >= c0; j--) { ctx.lineTo(px[j + 1], dn[j]); ctx.lineTo(px[j], dn[j]); }
+        ctx.closePath();
       }
       ctx.fill();
+      ctx.stroke();  // a flat envelope (min = max) still shows as a 1-px line
     }
     ctx.restore();
   }
