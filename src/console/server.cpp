@@ -368,6 +368,10 @@ void Server::set_status(const std::string& key, double value) {
   std::lock_guard lk(m_);
   status_[key] = value;
 }
+void Server::set_statuses(const std::vector<std::pair<std::string, double>>& values) {
+  std::lock_guard lk(m_);
+  for (const auto& [k, v] : values) status_[k] = v;
+}
 void Server::set_status_text(const std::string& key, const std::string& value) {
   std::lock_guard lk(m_);
   status_text_[key] = value;

@@ -83,6 +83,7 @@ void XcpBridge::run(Server& server) {
   const std::size_t late_i = index_of("frames_late"), lost_i = index_of("frames_lost");
   LiveStats tet(0.05), wake(0.5, 40000);  // bins: 0.05 us up to 2.5 ms; 0.5 us up to 20 ms
   double last_overruns = 0.0, last_overrun_t = -1.0;
+  double tet_from_step = NAN, tet_to_step = NAN;  // control steps of the first and last TET sample
   double last_step = NAN;
   std::uint64_t samples = 0, gaps = 0, reconnects = 0;
   while (!stop_.load()) {
@@ -162,7 +163,13 @@ void XcpBridge::run(Server& server) {
         }
         ++samples;
         ++rate_n;
-        if (tet_i < s.count && s.values[tet_i] > 0.0) tet.add(s.values[tet_i]);  // 0: the first step (no previous)
+        if (tet_i < s.count && s.values[tet_i] > 0.0) {  // 0: the first step (no previous)
+          tet.add(s.values[tet_i]);
+          if (step_i < s.count) {
+            if (tet.count() == 1) tet_from_step = s.values[step_i];
+            tet_to_step = s.values[step_i];
+          }
+        }
         if (wake_i < s.count) wake.add(s.values[wake_i]);
         // overruns as markers: at most one per 0.5 s of ECU time (a loaded machine overruns in bursts)
         if (over_i < s.count && s.values[over_i] > last_overruns && !(s.t_s - last_overrun_t < 0.5)) {
@@ -184,11 +191,10 @@ void XcpBridge::run(Server& server) {
           server.set_status("daq_samples", static_cast<double>(samples));
           server.set_status("daq_incomplete", static_cast<double>(client.samples_incomplete()));
           server.set_status("daq_gaps", static_cast<double>(gaps));
-          if (tet.count()) {
-            server.set_status("tet_mean_us", tet.mean());
-            server.set_status("tet_max_us", tet.max());
-            server.set_status("tet_p99_us", tet.quantile(0.99));
-          }
+          if (tet.count())  // with the control steps they cover (one update: the page sees all or none)
+            server.set_statuses({{"tet_mean_us", tet.mean()}, {"tet_max_us", tet.max()},
+                                 {"tet_p99_us", tet.quantile(0.99)}, {"tet_steps", static_cast<double>(tet.count())},
+                                 {"tet_from_step", tet_from_step}, {"tet_to_step", tet_to_step}});
           if (wake.count()) {
             server.set_status("wake_latency_mean_us", wake.mean());
             server.set_status("wake_latency_max_us", wake.max());

@@ -96,6 +96,8 @@ class Server {
   Feed& feed(std::size_t i = 0) noexcept;
   /// Status shown in the page (non-RT; any thread).
   void set_status(const std::string& key, double value);
+  /// Several values at once (a page never sees half of them updated).
+  void set_statuses(const std::vector<std::pair<std::string, double>>& values);
   void set_status_text(const std::string& key, const std::string& value);
   /// An event marker (non-RT; any thread). The newest 1000 are kept.
   void add_event(double t_s, const std::string& kind, const std::string& text);
