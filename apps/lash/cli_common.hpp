@@ -41,6 +41,7 @@ Command add_can(CLI::App& app);
 Command add_hil(CLI::App& app);
 Command add_xcp(CLI::App& app);
 Command add_monitor(CLI::App& app);
+Command add_console(CLI::App& app);
 
 /// The one catch-all (main): runs `fn`; InputError and std::invalid_argument → exit 2,
 /// any other lash::Error, std::exception or unknown exception → exit 1; a message on stderr,

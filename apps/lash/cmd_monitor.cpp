@@ -13,6 +13,7 @@
 
 #include "cli_common.hpp"
 #include "cmd_can.hpp"
+#include "console_options.hpp"
 #include "estimate_settings.hpp"
 #include "lash/monitor/monitor.hpp"
 #include "plot.hpp"
@@ -28,6 +29,7 @@ struct MonitorOptions {
   std::string report;
   std::string report_png;
   bool quiet = false;
+  ConsoleArgs console;
 };
 
 std::string num(double x) { return std::isfinite(x) ? fmt::format("{:.4g}", x) : "-"; }
@@ -123,10 +125,14 @@ int run(const CLI::App& sub, MonitorOptions& o) {
   can_cmd::install_stop_handler();
   const bool tty = !o.quiet && ::isatty(2) == 1;
   const auto wall0 = std::chrono::steady_clock::now();
+  std::unique_ptr<MonitorConsole> con;  // --console: the page of v, y, the estimates and events
+  if (o.console.enabled()) con = std::make_unique<MonitorConsole>(o.console, s);
   const auto result = monitor::run_monitor(s, &can_cmd::g_stop, [&](const monitor::Period& p, const auto& c) {
+    if (con) con->period(p, c);
     if (tty)
       status_line(p, c, std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count());
   });
+  if (con) con->stop();
   if (tty) std::fputs("\n", stderr);
   if (!o.quiet) print_summary(result);
   return result.alarm ? kExitAlarm : kExitOk;
@@ -163,6 +169,7 @@ Command add_monitor(CLI::App& app) {
   sub->add_flag("--quiet", o->quiet, "No status line and no summary on stderr");
   sub->add_option("--report", o->report, "Plot the history of this database instead (with -o)");
   sub->add_option("-o,--output", o->report_png, "PNG of --report");
+  add_console_options(sub, o->console);
   return {sub, [o, sub] { return run(*sub, *o); }};
 }
 

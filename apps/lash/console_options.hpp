@@ -6,7 +6,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include "lash/console/server.hpp"
 #include "lash/hil/settings.hpp"
+#include "lash/monitor/monitor.hpp"
 
 namespace lash::cli {
 
@@ -19,6 +21,8 @@ struct ConsoleArgs {
 };
 
 void add_console_options(CLI::App* app, ConsoleArgs& a);
+/// The server's options from the command line: address, port, read-only, uPlot's directory.
+console::ConsoleOptions console_options(const ConsoleArgs& a, std::string title);
 
 /// The console of `lash hil run`: its server is bound at construction (in the caller's network
 /// namespace, so the browser reaches it from the host), prints the URL; start() joins the bench's
@@ -28,6 +32,22 @@ class HilConsole {
   HilConsole(const ConsoleArgs& a, const hil::BenchSettings& s);
   ~HilConsole();
   void start();
+  void stop();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// The console of `lash monitor` (read-only page: v, y, the estimates with their 95 % bands and
+/// verdicts, events, samples/s and stale status). The constructor binds, prints the URL, starts
+/// the server and sets `s.on_sample` (the monitor's thread pushes into the console's ring only);
+/// period() is the monitor's period callback.
+class MonitorConsole {
+ public:
+  MonitorConsole(const ConsoleArgs& a, monitor::MonitorSettings& s);
+  ~MonitorConsole();
+  void period(const monitor::Period& p, const monitor::MonitorCounts& c);
   void stop();
 
  private:

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
         add_hil(app),
         add_xcp(app),
         add_monitor(app),
+        add_console(app),
     };
     try {
       app.parse(argc, argv);

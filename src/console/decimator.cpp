@@ -20,7 +20,7 @@ Decimator::Decimator(const DecimatorConfig& c) : c_(c) {
   levels_.resize(c_.levels);
   for (auto& l : levels_) {
     l.width = w;
-    l.index.assign(c_.buckets, -1);
+    l.index.assign(c_.buckets, Level::kNoBucket);  // not -1: that is the bucket of t in [-width, 0)
     l.lo.assign(c_.buckets * c_.signals, 0.0);
     l.hi.assign(c_.buckets * c_.signals, 0.0);
     w *= 4.0;
@@ -42,9 +42,13 @@ void Decimator::add(double t_s, std::span<const double> values) noexcept {
       for (std::size_t s = 0; s < n; ++s) lo[s] = hi[s] = values[s];
       continue;
     }
-    for (std::size_t s = 0; s < n; ++s) {
-      lo[s] = std::min(lo[s], values[s]);
-      hi[s] = std::max(hi[s], values[s]);
+    for (std::size_t s = 0; s < n; ++s) {  // NaN (no value yet) never hides a value
+      if (std::isnan(lo[s])) {
+        lo[s] = hi[s] = values[s];
+      } else if (!std::isnan(values[s])) {
+        lo[s] = std::min(lo[s], values[s]);
+        hi[s] = std::max(hi[s], values[s]);
+      }
     }
   }
   last_t_ = std::max(last_t_, t_s);
@@ -67,6 +71,8 @@ DecimatedView Decimator::view(double t_end, double window_s, std::size_t columns
   const double t0 = t_end - window_s;
   const double col_w = std::max(window_s / static_cast<double>(columns), lv->width);
   const auto ncol = static_cast<std::size_t>(std::ceil(window_s / col_w));
+  v.t0_s = t0;
+  v.col_s = col_w;
   const double nan = std::numeric_limits<double>::quiet_NaN();
   v.t_s.resize(ncol);
   for (std::size_t s = 0; s < n; ++s) {
@@ -93,6 +99,49 @@ DecimatedView Decimator::view(double t_end, double window_s, std::size_t columns
     }
   }
   return v;
+}
+
+std::size_t Decimator::view_f32(double t_end, double window_s, std::size_t columns, std::span<const std::size_t> signals,
+                                std::vector<float>& out, double& t0_s, double& col_s, double& bucket_s) const {
+  out.clear();
+  t0_s = col_s = bucket_s = 0.0;
+  if (!(window_s > 0.0) || columns == 0) return 0;
+  const std::size_t n = c_.signals;
+  const Level* lv = &levels_.back();
+  for (const auto& l : levels_)
+    if (l.width * static_cast<double>(c_.buckets - 1) >= window_s) {
+      lv = &l;
+      break;
+    }
+  bucket_s = lv->width;
+  t0_s = t_end - window_s;
+  col_s = std::max(window_s / static_cast<double>(columns), lv->width);
+  const auto ncol = static_cast<std::size_t>(std::ceil(window_s / col_s));
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  out.assign(signals.size() * 2 * ncol, nan);
+  const auto nb = static_cast<std::int64_t>(c_.buckets);
+  for (std::size_t c = 0; c < ncol; ++c) {
+    const double a = t0_s + static_cast<double>(c) * col_s;
+    const auto b0 = static_cast<std::int64_t>(std::floor(a / lv->width));
+    auto b1 = static_cast<std::int64_t>(std::floor((a + col_s) / lv->width));
+    if (b1 <= b0) b1 = b0 + 1;
+    for (std::int64_t b = b0; b < b1; ++b) {
+      const auto slot = static_cast<std::size_t>(((b % nb) + nb) % nb);
+      if (lv->index[slot] != b) continue;
+      const double* lo = &lv->lo[slot * n];
+      const double* hi = &lv->hi[slot * n];
+      for (std::size_t k = 0; k < signals.size(); ++k) {
+        const std::size_t s = signals[k];
+        if (s >= n) continue;
+        float& m = out[(2 * k) * ncol + c];
+        float& M = out[(2 * k + 1) * ncol + c];
+        const auto l = static_cast<float>(lo[s]), h = static_cast<float>(hi[s]);
+        m = std::isnan(m) ? l : std::min(m, l);
+        M = std::isnan(M) ? h : std::max(M, h);
+      }
+    }
+  }
+  return ncol;
 }
 
 std::size_t Decimator::memory_bytes() const noexcept {

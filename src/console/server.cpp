@@ -2,7 +2,9 @@
 
 #include <sys/random.h>
 
+#include <bit>
 #include <cerrno>
+#include <cmath>
 #include <chrono>
 #include <cstring>
 #include <fstream>
@@ -44,6 +46,9 @@ void ConsoleOptions::validate() const {
   if (signals.empty() || signals.size() > kMaxSignals)
     throw InputError("", 0, "--console", "1.." + std::to_string(kMaxSignals) + " signals, got " +
                                               std::to_string(signals.size()));
+  for (const auto& f : extra_feeds)
+    if (f.empty() || f.size() > kMaxSignals)
+      throw InputError("", 0, "--console", "an extra feed needs 1.." + std::to_string(kMaxSignals) + " signals");
 }
 
 namespace {
@@ -67,6 +72,12 @@ bool loopback(const std::string& a) { return a == "127.0.0.1" || a == "::1" || a
 
 }  // namespace
 
+struct Server::Group {
+  explicit Group(const DecimatorConfig& d) : dec(d) {}
+  Feed feed;
+  Decimator dec;
+};
+
 struct Server::Impl {
   httplib::Server http;
   std::string uplot_js, uplot_css;
@@ -75,13 +86,15 @@ struct Server::Impl {
 Server::Server(ConsoleOptions options, Tuner tuner)
     : impl_(std::make_unique<Impl>()),
       o_(std::move(options)),
-      tuner_(std::move(tuner)),
-      dec_([&] {
-        o_.validate();
-        DecimatorConfig d = o_.decimation;
-        d.signals = o_.signals.size();
-        return d;
-      }()) {
+      tuner_(std::move(tuner)) {
+  o_.validate();
+  for (std::size_t g = 0; g <= o_.extra_feeds.size(); ++g) {
+    const auto& names = g == 0 ? o_.signals : o_.extra_feeds[g - 1];
+    DecimatorConfig d = o_.decimation;
+    d.signals = names.size();
+    groups_.push_back(std::make_unique<Group>(d));
+    all_signals_.insert(all_signals_.end(), names.begin(), names.end());
+  }
   impl_->uplot_js = read_file(o_.uplot_dir / "uPlot.iife.min.js");
   impl_->uplot_css = read_file(o_.uplot_dir / "uPlot.min.css");
   if (impl_->uplot_js.empty() || impl_->uplot_css.empty())
@@ -148,7 +161,7 @@ Server::Server(ConsoleOptions options, Tuner tuner)
     if (!api_ok(req, res, false)) return;
     nlohmann::json j;
     j["title"] = o_.title;
-    j["signals"] = o_.signals;
+    j["signals"] = all_signals_;
     j["read_only"] = o_.read_only;
     nlohmann::json ps = nlohmann::json::array();
     {
@@ -156,50 +169,108 @@ Server::Server(ConsoleOptions options, Tuner tuner)
       for (const auto& p : o_.params)
         ps.push_back({{"name", p.name}, {"unit", p.unit}, {"doc", p.doc}, {"min", p.min}, {"max", p.max},
                       {"value", param_values_[p.name]}});
-      j["memory_bytes"] = dec_.memory_bytes();
+      std::size_t mem = 0;
+      for (const auto& g : groups_) mem += g->dec.memory_bytes();
+      j["memory_bytes"] = mem;
     }
     j["params"] = ps;
     common(res);
     res.set_content(j.dump(), "application/json");
   });
 
-  h.Get("/api/data", [this, api_ok, common](const httplib::Request& req, httplib::Response& res) {
+  // The decimated window, binary (little-endian): 64 bytes of header ("LSH1", u32 columns,
+  // u32 signals, u32 0, f64 t_end, t0, column width, bucket width [s], samples, drops), then
+  // per signal asked for (sig=i,j,..; default all) `columns` float32 minima, then maxima.
+  h.Get("/api/frame", [this, api_ok, common](const httplib::Request& req, httplib::Response& res) {
     if (!api_ok(req, res, false)) return;
     double window = 10.0;
     std::size_t columns = 800;
-    std::uint64_t since = 0;
+    std::vector<std::size_t> sig;
     try {
       if (req.has_param("window")) window = std::stod(req.get_param_value("window"));
       if (req.has_param("columns")) columns = std::stoul(req.get_param_value("columns"));
-      if (req.has_param("since")) since = std::stoull(req.get_param_value("since"));
+      if (req.has_param("sig")) {
+        std::stringstream ss(req.get_param_value("sig"));
+        for (std::string item; std::getline(ss, item, ',');)
+          if (!item.empty()) sig.push_back(std::stoul(item));
+      }
     } catch (const std::exception&) {
       res.status = 400;
       return;
     }
+    if (!(window > 0.0) || !std::isfinite(window)) window = 10.0;
     window = std::clamp(window, 0.05, 36000.0);
     columns = std::clamp<std::size_t>(columns, 10, 4000);
+    std::sort(sig.begin(), sig.end());
+    sig.erase(std::unique(sig.begin(), sig.end()), sig.end());
+    while (!sig.empty() && sig.back() >= all_signals_.size()) sig.pop_back();
+    if (sig.empty())
+      for (std::size_t i = 0; i < all_signals_.size(); ++i) sig.push_back(i);
+    std::vector<float> mm, part;
+    double t_end = 0, t0 = 0, col = 0, bucket = 0, samples = 0;
+    std::size_t ncol = 0;
+    {
+      std::lock_guard lk(m_);
+      for (const auto& g : groups_) t_end = std::max(t_end, g->dec.last_t());
+      std::size_t first = 0, k = 0;
+      for (const auto& g : groups_) {  // the groups hold consecutive signals; sig is sorted
+        std::vector<std::size_t> local;
+        for (; k < sig.size() && sig[k] < first + g->dec.config().signals; ++k) local.push_back(sig[k] - first);
+        first += g->dec.config().signals;
+        if (local.empty()) continue;
+        ncol = g->dec.view_f32(t_end, window, columns, local, part, t0, col, bucket);
+        mm.insert(mm.end(), part.begin(), part.end());
+      }
+      samples = static_cast<double>(groups_.front()->dec.samples());
+      ++frames_served_;
+    }
+    static_assert(std::endian::native == std::endian::little, "the frame is written little-endian");
+    std::string body(64 + mm.size() * sizeof(float), '\0');
+    const std::uint32_t u[4] = {0x3148534Cu /* "LSH1" */, static_cast<std::uint32_t>(ncol),
+                                static_cast<std::uint32_t>(sig.size()), 0};
+    const double d[6] = {t_end, t0, col, bucket, samples, static_cast<double>(drops())};
+    std::memcpy(body.data(), u, sizeof u);
+    std::memcpy(body.data() + 16, d, sizeof d);
+    if (!mm.empty()) std::memcpy(body.data() + 64, mm.data(), mm.size() * sizeof(float));
+    common(res);
+    res.set_content(std::move(body), "application/octet-stream");
+  });
+
+  // Status, events and estimates newer than the ids the page has (since, est_since), params.
+  h.Get("/api/status", [this, api_ok, common](const httplib::Request& req, httplib::Response& res) {
+    if (!api_ok(req, res, false)) return;
+    std::uint64_t since = 0, est_since = 0;
+    try {
+      if (req.has_param("since")) since = std::stoull(req.get_param_value("since"));
+      if (req.has_param("est_since")) est_since = std::stoull(req.get_param_value("est_since"));
+    } catch (const std::exception&) {
+      res.status = 400;
+      return;
+    }
     nlohmann::json j;
     {
       std::lock_guard lk(m_);
-      const double t_end = dec_.last_t();
-      const DecimatedView v = dec_.view(t_end, window, columns);
-      j["t_end"] = t_end;
-      j["bucket_s"] = v.bucket_s;
-      j["t"] = v.t_s;
-      j["min"] = v.min;
-      j["max"] = v.max;
-      j["samples"] = dec_.samples();
+      j["t_end"] = groups_.front()->dec.last_t();
+      j["samples"] = groups_.front()->dec.samples();
+      j["frames_served"] = frames_served_;
       j["status"] = status_;
       j["status_text"] = status_text_;
       nlohmann::json ev = nlohmann::json::array();
       for (const auto& e : events_)
         if (e.id > since) ev.push_back({{"id", e.id}, {"t", e.t_s}, {"kind", e.kind}, {"text", e.text}});
       j["events"] = ev;
+      nlohmann::json es = nlohmann::json::array();
+      const auto num = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
+      for (const auto& e : estimates_)
+        if (e.id > est_since)
+          es.push_back({{"id", e.id}, {"t", e.t_s}, {"name", e.name}, {"value", num(e.value)}, {"lo", num(e.lo)},
+                        {"hi", num(e.hi)}, {"identified", e.identified}});
+      j["estimates"] = es;
       nlohmann::json pv;
       for (const auto& [k, val] : param_values_) pv[k] = val;
       j["params"] = pv;
     }
-    j["drops"] = feed_.drops();
+    j["drops"] = drops();
     common(res);
     res.set_content(j.dump(), "application/json");
   });
@@ -240,6 +311,8 @@ Server::Server(ConsoleOptions options, Tuner tuner)
     res.set_content(out.dump(), "application/json");
   });
 
+  h.set_tcp_nodelay(true);             // small answers go out at once (no Nagle / delayed-ACK wait)
+  h.set_keep_alive_max_count(1000000);  // one connection for the page's stream of frames
   if (o_.port == 0) {
     port_ = h.bind_to_any_port(o_.bind);
     if (port_ <= 0) throw InputError("", 0, "--console-bind", "cannot bind " + o_.bind + " (any port)");
@@ -262,8 +335,9 @@ void Server::start() {
     while (!stop_.load()) {
       {
         std::lock_guard lk(m_);
-        for (std::size_t i = 0; i < Feed::kCapacity && feed_.pop(s); ++i)
-          dec_.add(s.t_s, std::span<const double>(s.values.data(), std::min<std::size_t>(s.count, kMaxSignals)));
+        for (auto& g : groups_)
+          for (std::size_t i = 0; i < Feed::kCapacity && g->feed.pop(s); ++i)
+            g->dec.add(s.t_s, std::span<const double>(s.values.data(), std::min<std::size_t>(s.count, kMaxSignals)));
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
@@ -277,6 +351,14 @@ void Server::stop() {
   if (drain_thread_.joinable()) drain_thread_.join();
 }
 
+Feed& Server::feed(std::size_t i) noexcept { return groups_[std::min(i, groups_.size() - 1)]->feed; }
+
+std::uint64_t Server::drops() const noexcept {
+  std::uint64_t n = 0;
+  for (const auto& g : groups_) n += g->feed.drops();
+  return n;
+}
+
 std::string Server::url() const {
   const std::string host = o_.bind.find(':') != std::string::npos ? "[" + o_.bind + "]" : o_.bind;
   return "http://" + host + ":" + std::to_string(port_) + "/?token=" + token_;
@@ -286,6 +368,10 @@ void Server::set_status(const std::string& key, double value) {
   std::lock_guard lk(m_);
   status_[key] = value;
 }
+void Server::set_statuses(const std::vector<std::pair<std::string, double>>& values) {
+  std::lock_guard lk(m_);
+  for (const auto& [k, v] : values) status_[k] = v;
+}
 void Server::set_status_text(const std::string& key, const std::string& value) {
   std::lock_guard lk(m_);
   status_text_[key] = value;
@@ -294,6 +380,11 @@ void Server::add_event(double t_s, const std::string& kind, const std::string& t
   std::lock_guard lk(m_);
   events_.push_back({next_event_++, t_s, kind, text});
   while (events_.size() > 1000) events_.pop_front();
+}
+void Server::add_estimate(double t_s, const std::string& name, double value, double lo, double hi, bool identified) {
+  std::lock_guard lk(m_);
+  estimates_.push_back({next_estimate_++, t_s, name, value, lo, hi, identified});
+  while (estimates_.size() > 20000) estimates_.pop_front();
 }
 void Server::set_param_value(const std::string& name, double value) {
   std::lock_guard lk(m_);

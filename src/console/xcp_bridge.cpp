@@ -7,10 +7,15 @@
 
 #include "lash/can/bus.hpp"
 #include "lash/can/xcp_client.hpp"
+#include "lash/console/live_stats.hpp"
 
 namespace lash::console {
 namespace xcp = can::xcp;
 using namespace std::chrono_literals;
+
+double steady_s() noexcept {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
 
 XcpBridge::XcpBridge(XcpBridgeOptions o) : o_(std::move(o)) {
   for (const auto& ob : o_.objects) (ob.kind == xcp::Kind::measurement ? meas_ : cal_).push_back(ob);
@@ -67,11 +72,18 @@ void XcpBridge::run(Server& server) {
     server.set_status_text("xcp", std::string("cannot open the bus: ") + e.what());
     return;
   }
-  std::size_t state_i = meas_.size(), step_i = meas_.size();
-  for (std::size_t i = 0; i < meas_.size(); ++i) {
-    if (meas_[i].name == o_.state_signal) state_i = i;
-    if (meas_[i].name == "control_step") step_i = i;
-  }
+  const auto index_of = [&](const std::string& name) {
+    for (std::size_t i = 0; i < meas_.size(); ++i)
+      if (meas_[i].name == name) return i;
+    return meas_.size();
+  };
+  const std::size_t state_i = index_of(o_.state_signal), step_i = index_of("control_step");
+  // The loop's figures (hil/calibration.hpp): TET and wake-up latency per step [us], counters.
+  const std::size_t tet_i = index_of("tet_us"), wake_i = index_of("wake_latency_us"), over_i = index_of("overruns");
+  const std::size_t late_i = index_of("frames_late"), lost_i = index_of("frames_lost");
+  LiveStats tet(0.05), wake(0.5, 40000);  // bins: 0.05 us up to 2.5 ms; 0.5 us up to 20 ms
+  double last_overruns = 0.0, last_overrun_t = -1.0;
+  double tet_from_step = NAN, tet_to_step = NAN;  // control steps of the first and last TET sample
   double last_step = NAN;
   std::uint64_t samples = 0, gaps = 0, reconnects = 0;
   while (!stop_.load()) {
@@ -142,6 +154,8 @@ void XcpBridge::run(Server& server) {
         s.count = static_cast<std::uint32_t>(std::min(smp->values.size(), kMaxSignals));
         for (std::size_t i = 0; i < s.count; ++i) s.values[i] = smp->values[i];
         server.feed().push(s);
+        if (const double off = steady_s() - s.t_s, cur = offset_.load(); std::isnan(cur) || off < cur)
+          offset_.store(off);
         if (step_i < s.count) {  // a control step the DAQ did not deliver
           if (!std::isnan(last_step) && last_step >= 0 && s.values[step_i] > last_step + 1)
             gaps += static_cast<std::uint64_t>(s.values[step_i] - last_step - 1);
@@ -149,6 +163,20 @@ void XcpBridge::run(Server& server) {
         }
         ++samples;
         ++rate_n;
+        if (tet_i < s.count && s.values[tet_i] > 0.0) {  // 0: the first step (no previous)
+          tet.add(s.values[tet_i]);
+          if (step_i < s.count) {
+            if (tet.count() == 1) tet_from_step = s.values[step_i];
+            tet_to_step = s.values[step_i];
+          }
+        }
+        if (wake_i < s.count) wake.add(s.values[wake_i]);
+        // overruns as markers: at most one per 0.5 s of ECU time (a loaded machine overruns in bursts)
+        if (over_i < s.count && s.values[over_i] > last_overruns && !(s.t_s - last_overrun_t < 0.5)) {
+          server.add_event(s.t_s, "overrun", fmt::format("{} overrun(s) so far", s.values[over_i]));
+          last_overruns = s.values[over_i];
+          last_overrun_t = s.t_s;
+        }
         if (state_i < s.count && s.values[state_i] != last_state) {
           if (!std::isnan(last_state))
             server.add_event(s.t_s, "state",
@@ -163,6 +191,18 @@ void XcpBridge::run(Server& server) {
           server.set_status("daq_samples", static_cast<double>(samples));
           server.set_status("daq_incomplete", static_cast<double>(client.samples_incomplete()));
           server.set_status("daq_gaps", static_cast<double>(gaps));
+          if (tet.count())  // with the control steps they cover (one update: the page sees all or none)
+            server.set_statuses({{"tet_mean_us", tet.mean()}, {"tet_max_us", tet.max()},
+                                 {"tet_p99_us", tet.quantile(0.99)}, {"tet_steps", static_cast<double>(tet.count())},
+                                 {"tet_from_step", tet_from_step}, {"tet_to_step", tet_to_step}});
+          if (wake.count()) {
+            server.set_status("wake_latency_mean_us", wake.mean());
+            server.set_status("wake_latency_max_us", wake.max());
+            server.set_status("wake_latency_p99_us", wake.quantile(0.99));
+          }
+          if (over_i < s.count) server.set_status("overruns", s.values[over_i]);
+          if (late_i < s.count) server.set_status("frames_late", s.values[late_i]);
+          if (lost_i < s.count) server.set_status("frames_lost", s.values[lost_i]);
           t_rate = now;
           rate_n = 0;
         }

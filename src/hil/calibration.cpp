@@ -35,7 +35,7 @@ constexpr std::array<CalibrationField, 12> kCalibration{{
      "adaptation: square-wave dither amplitude on u (scenario law, adaptive only)", {}},
 }};
 
-constexpr std::array<MeasurementField, 8> kMeasurements{{
+constexpr std::array<MeasurementField, 13> kMeasurements{{
     {"reference_kPa", &MeasurementPage::reference_kPa, "kPa", -5000.0, 5000.0, "reference r(m)"},
     {"measured_kPa", &MeasurementPage::measured_kPa, "kPa", -5000.0, 5000.0, "decoded pilot pressure y(m)"},
     {"current_mA", &MeasurementPage::current_mA, "mA", -2000.0, 2000.0, "commanded current i(m)"},
@@ -44,6 +44,11 @@ constexpr std::array<MeasurementField, 8> kMeasurements{{
     {"state", &MeasurementPage::state, "", 0.0, 5.0, "safe-state machine state (docs/hil.md)"},
     {"sensor_fresh", &MeasurementPage::sensor_fresh, "", 0.0, 1.0, "a plausible new sensor frame was used"},
     {"dropped", &MeasurementPage::dropped, "", 0.0, 64.0, "implausible sensor frames dropped in the step"},
+    {"tet_us", &MeasurementPage::tet_us, "us", 0.0, 1e7, "TET of the previous step"},
+    {"wake_latency_us", &MeasurementPage::wake_latency_us, "us", -1e7, 1e7, "wake-up latency of this step"},
+    {"overruns", &MeasurementPage::overruns, "", 0.0, 4e9, "overruns of the loop so far"},
+    {"frames_late", &MeasurementPage::frames_late, "", 0.0, 4e9, "sensor frames accepted late so far"},
+    {"frames_lost", &MeasurementPage::frames_lost, "", 0.0, 4e9, "sensor frames lost so far"},
 }};
 }  // namespace
 

@@ -282,7 +282,13 @@ MasterRun run_master_node(const BenchSettings& s, const MasterRunOptions& o, con
     writer.set_epoch(out.stats.epoch_s);
     out.stats.result = loop.run_with_io(
         [&]() noexcept { ctl.pull(); },
-        [&](std::size_t, std::int64_t t_ns) noexcept {
+        [&](std::size_t k, std::int64_t t_ns) noexcept {
+          if (link) {  // console status over XCP: the previous step's TET, this step's wake-up latency
+            const auto rec = loop.records();
+            master.set_loop_figures(rec.empty() ? 0.0 : static_cast<double>(rec.back().tet_ns) * 1e-3,
+                                    static_cast<double>(t_ns - static_cast<std::int64_t>(k) * loop.config().period_ns) * 1e-3,
+                                    static_cast<double>(loop.overruns().size()));
+          }
           const bool ok = master.step(ctl, static_cast<double>(t_ns) * 1e-9);
           return ok && master.control_steps() < N;
         },

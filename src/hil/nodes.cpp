@@ -464,6 +464,11 @@ bool MasterNode::step(can::Bus& bus, double now_s) noexcept {
     m.page.state = static_cast<double>(state_);
     m.page.sensor_fresh = fresh_ ? 1.0 : 0.0;
     m.page.dropped = static_cast<double>(dropped);
+    m.page.tet_us = loop_tet_us_;  // console status (docs/console.md): the loop's figures, the frame counters
+    m.page.wake_latency_us = loop_wake_us_;
+    m.page.overruns = loop_overruns_;
+    m.page.frames_late = static_cast<double>(sens_.late);
+    m.page.frames_lost = static_cast<double>(sens_.lost);
     if (!link_->samples.push(m)) link_->samples_lost.fetch_add(1, std::memory_order_relaxed);
   }
   ++k_;

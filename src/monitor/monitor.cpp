@@ -239,6 +239,7 @@ class Pipeline {
     v_.push_back(v);
     y_.push_back(y);
     ++counts_.samples;
+    if (s_.on_sample) s_.on_sample(t, v, y);  // the console's observer (monitor.hpp)
     if (record_.is_open()) record_ << format_double(t) << ',' << format_double(v) << ',' << format_double(y) << '\n';
     // bounded memory: once the kept samples span 2 windows, those before the last window go
     // (amortised O(1) per sample: each sample is moved at most once)

@@ -24,9 +24,11 @@ struct DecimatorConfig {
 
 /// One decimated view: column times (their starts) and per signal min/max (NaN = empty column).
 struct DecimatedView {
-  std::vector<double> t_s;
+  std::vector<double> t_s;                    ///< column c starts at t0_s + c * col_s
   std::vector<std::vector<double>> min, max;  ///< [signal][column]
   double bucket_s = 0.0;                      ///< the level's bucket width used
+  double t0_s = 0.0;                          ///< start of column 0 [s]
+  double col_s = 0.0;                         ///< width of a column [s]
 };
 
 class Decimator {
@@ -36,6 +38,10 @@ class Decimator {
   void add(double t_s, std::span<const double> values) noexcept;
   /// The window [t_end - window_s, t_end) in at most `columns` columns.
   DecimatedView view(double t_end, double window_s, std::size_t columns) const;
+  /// The same for the signals listed (indices < signals; others skipped), min/max as float.
+  /// out: per listed signal, ncol minima then ncol maxima (NaN = empty column). Returns ncol.
+  std::size_t view_f32(double t_end, double window_s, std::size_t columns, std::span<const std::size_t> signals,
+                       std::vector<float>& out, double& t0_s, double& col_s, double& bucket_s) const;
   double last_t() const noexcept { return last_t_; }
   std::uint64_t samples() const noexcept { return samples_; }
   /// Bytes held (constant after construction).
@@ -45,7 +51,8 @@ class Decimator {
  private:
   struct Level {
     double width = 0.0;
-    std::vector<std::int64_t> index;  ///< bucket number held by each slot (-1: none)
+    static constexpr std::int64_t kNoBucket = INT64_MIN;
+    std::vector<std::int64_t> index;  ///< bucket number held by each slot (kNoBucket: none)
     std::vector<double> lo, hi;       ///< [slot * signals + s]
   };
   DecimatorConfig c_;

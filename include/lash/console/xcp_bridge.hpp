@@ -10,6 +10,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -22,6 +23,9 @@
 #include "lash/console/server.hpp"
 
 namespace lash::console {
+
+/// CLOCK_MONOTONIC (std::chrono::steady_clock) in seconds.
+double steady_s() noexcept;
 
 struct XcpBridgeOptions {
   std::string bus;                       ///< e.g. udp:239.74.163.2:43113
@@ -46,6 +50,9 @@ class XcpBridge {
   /// Starts the thread (in the caller's network namespace) feeding `server`.
   void start(Server& server);
   void stop();  ///< idempotent
+  /// steady_s() - (the ECU's DAQ time) at the earliest-arriving DAQ sample so far [s]: maps a time
+  /// taken on this machine onto the ECU's clock (other taps of the bus). NaN before any sample.
+  double ecu_time_offset_s() const noexcept { return offset_.load(std::memory_order_relaxed); }
   /// Thread-safe; blocks until the bridge thread did the write and read-back (≤ 3 s).
   TuneResult tune(const std::string& name, double value);
 
@@ -64,6 +71,7 @@ class XcpBridge {
   std::deque<std::shared_ptr<Request>> queue_;
   bool connected_ = false;
   std::atomic<bool> stop_{false};
+  std::atomic<double> offset_{std::numeric_limits<double>::quiet_NaN()};
   std::thread thread_;
 };
 

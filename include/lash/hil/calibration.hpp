@@ -61,6 +61,12 @@ struct MeasurementPage {
   double state = 0.0;           ///< NodeState as a number
   double sensor_fresh = 0.0;    ///< 1 when a plausible new sensor frame was used
   double dropped = 0.0;         ///< implausible sensor frames dropped in the step
+  // The loop's figures, for the live console's status panel (docs/console.md); not master.csv columns.
+  double tet_us = 0.0;            ///< TET of the previous step [µs] (0 in the first)
+  double wake_latency_us = 0.0;   ///< wake-up latency of this step [µs]
+  double overruns = 0.0;          ///< overruns of the loop so far
+  double frames_late = 0.0;       ///< sensor frames accepted late so far (SeqTracker::late)
+  double frames_lost = 0.0;       ///< sensor frames lost so far (SeqTracker::lost)
 };
 
 struct MeasurementField {

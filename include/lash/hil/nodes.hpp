@@ -321,6 +321,11 @@ class MasterNode {
   /// calibration page the thread handed over, and ends by pushing its measurements. nullptr
   /// detaches. Not real-time safe (call before the loop).
   void attach(XcpLink* link) noexcept { link_ = link; }
+  /// The loop's figures for the XCP measurements (console status): TET of the previous step,
+  /// wake-up latency of this one [µs], overruns so far. Real-time safe (three stores).
+  void set_loop_figures(double tet_prev_us, double wake_us, double overruns) noexcept {
+    loop_tet_us_ = tet_prev_us, loop_wake_us_ = wake_us, loop_overruns_ = overruns;
+  }
   const CalibrationPage& calibration() const noexcept { return cal_; }
   /// Empties the step log and the bus log for the next step. A node run with log_capacity = 1
   /// and bus_log_capacity = kStepFrames calls it after handing each step's row and frames to
@@ -372,6 +377,7 @@ class MasterNode {
   std::uint64_t bus_log_dropped_ = 0;
   CalibrationPage cal_;
   XcpLink* link_ = nullptr;
+  double loop_tet_us_ = 0.0, loop_wake_us_ = 0.0, loop_overruns_ = 0.0;  ///< set_loop_figures (console)
   std::size_t next_change_ = 0;
   std::vector<CalibrationEvent> cal_events_;
   std::size_t n_cal_events_ = 0;

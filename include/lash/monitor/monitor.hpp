@@ -48,6 +48,9 @@ struct MonitorSettings {
   std::string record_csv;          ///< "" = none: t,v,y as fed to the estimator
   std::string jsonl;               ///< "" = none, "-" = stdout
   std::string db;                  ///< "" = none: SQLite history
+  /// Observer of each sample fed to the estimator (t [s since the first], v, y), called on the
+  /// monitor's thread: the live console (docs/console.md). Must not block. Empty: none.
+  std::function<void(double t, double v, double y)> on_sample;
 };
 
 /// Reads a monitor config: `[alarms]` and `[drift]` (events.hpp) and, for the estimator,
