@@ -214,10 +214,12 @@ class SwitchingEstimator : public Model {
   /// Updates of side s (of the model, when one-sided).
   std::uint64_t updates(Side s = Side::right) const noexcept { return Model::side_updates(s); }
   /// Updates of key (side, +) or (side, −).
-  std::uint64_t updates(Side s, bool plus) const noexcept
-    requires(traits.keys_by_direction)
-  {
-    return Model::key_updates(s, plus);
+  /// (A member template: an explicit instantiation of the class leaves it out where the model has
+  /// no such keys.)
+  template <class M = Model>
+    requires(M::traits.keys_by_direction)
+  std::uint64_t updates(Side s, bool plus) const noexcept {
+    return M::key_updates(s, plus);
   }
   /// The deadzone edge c that side s's regression points at, identified or not: the identified c,
   /// else the model's c from the raw estimate once the side has min_updates updates; NaN when
