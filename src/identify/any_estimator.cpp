@@ -2,58 +2,50 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
+#include <stdexcept>
 
 #include "lash/metrics/first_order.hpp"
 
 namespace lash {
 
-namespace {
-using Var = std::variant<LinearEstimator, InputDeadzoneEstimator, OutputDeadzoneEstimator, DeadzoneDeadbandEstimator,
-                         CoupledCartsEstimator>;
-Var make(const EstimatorConfig& c) {
-  switch (c.model) {
-    case ModelKind::linear: return Var(std::in_place_type<LinearEstimator>, c);
-    case ModelKind::input_deadzone: return Var(std::in_place_type<InputDeadzoneEstimator>, c);
-    case ModelKind::output_deadzone: return Var(std::in_place_type<OutputDeadzoneEstimator>, c);
-    case ModelKind::deadzone_deadband: return Var(std::in_place_type<DeadzoneDeadbandEstimator>, c);
-    case ModelKind::coupled_carts: return Var(std::in_place_type<CoupledCartsEstimator>, c);
-  }
-  throw std::invalid_argument("unknown model");
+AnyEstimator::Variant AnyEstimator::make(const EstimatorConfig& c) {
+  std::optional<Variant> v;
+  if (!with_model(c.model, [&]<class Model>() { v.emplace(std::in_place_type<SwitchingEstimator<Model>>, c); }))
+    throw std::invalid_argument("unknown model");
+  return std::move(*v);
 }
-}  // namespace
 
 AnyEstimator::AnyEstimator(const EstimatorConfig& cfg) : cfg_(cfg), e_(make(cfg)) {}
 
-std::vector<std::string> AnyEstimator::param_names() const {
-  switch (cfg_.model) {
-    case ModelKind::linear: return {"a1", "b1"};
-    case ModelKind::input_deadzone:
-    case ModelKind::output_deadzone: return {"a1_r", "b1_r", "c_r", "a1_l", "b1_l", "c_l"};
-    case ModelKind::deadzone_deadband: return {"a1_r", "b1_r", "c_r", "d_r", "a1_l", "b1_l", "c_l", "d_l"};
-    case ModelKind::coupled_carts: return {"a1_r", "b1_r", "c_r", "a1_l", "b1_l", "c_l", "d"};
+std::vector<std::string> AnyEstimator::param_names() const { return lash::param_names(model_traits(cfg_.model)); }
+
+std::vector<std::string> param_names(const ModelTraits& t) {
+  if (!t.two_sided) return {"a1", "b1"};
+  std::vector<std::string> n;
+  for (const char* s : {"_r", "_l"}) {
+    for (const char* p : {"a1", "b1", "c", "d"})
+      if ((p[0] != 'c' || t.has_c) && (p[0] != 'd' || t.has_side_d)) n.push_back(p + std::string(s));
   }
-  return {};
+  if (t.has_shared_d) n.emplace_back("d");
+  return n;
 }
 
 void AnyEstimator::param_values(std::span<double> out) const noexcept {
+  const ModelTraits& t = model_traits(cfg_.model);
   const SideParams r = params(Side::right), l = params(Side::left);
   std::size_t i = 0;
   auto put = [&](double x) noexcept {
     if (i < out.size()) out[i++] = x;
   };
-  switch (cfg_.model) {
-    case ModelKind::linear: put(r.a1); put(r.b1); break;
-    case ModelKind::input_deadzone:
-    case ModelKind::output_deadzone:
-      put(r.a1); put(r.b1); put(r.c); put(l.a1); put(l.b1); put(l.c);
-      break;
-    case ModelKind::deadzone_deadband:
-      put(r.a1); put(r.b1); put(r.c); put(r.d); put(l.a1); put(l.b1); put(l.c); put(l.d);
-      break;
-    case ModelKind::coupled_carts:
-      put(r.a1); put(r.b1); put(r.c); put(l.a1); put(l.b1); put(l.c); put(r.d);
-      break;
+  for (const SideParams* p : {&r, &l}) {
+    put(p->a1);
+    put(p->b1);
+    if (!t.two_sided) return;
+    if (t.has_c) put(p->c);
+    if (t.has_side_d) put(p->d);
   }
+  if (t.has_shared_d) put(r.d);
 }
 
 EstimateReport AnyEstimator::report() const {
@@ -71,27 +63,25 @@ EstimateReport AnyEstimator::report() const {
   };
   fill(rep.right, Side::right);
   fill(rep.left, Side::left);
+  const ModelTraits& t = model_traits(cfg_.model);
+  rep.has_c = t.has_c;
+  rep.has_side_d = t.has_side_d;
+  rep.has_shared_d = t.has_shared_d;
   std::visit(
       [&](const auto& e) {
         using E = std::decay_t<decltype(e)>;
         rep.skipped = e.skipped();
         rep.fit_nrmse = e.fit_nrmse();
-        if constexpr (std::is_same_v<E, LinearEstimator>) {
-          rep.right.updates = {{"all", e.updates()}};
-        } else if constexpr (std::is_same_v<E, DeadzoneDeadbandEstimator>) {
-          rep.has_c = rep.has_side_d = true;
-          rep.right.updates = {{"+", e.updates(Side::right, true)}, {"-", e.updates(Side::right, false)}};
-          rep.left.updates = {{"+", e.updates(Side::left, true)}, {"-", e.updates(Side::left, false)}};
-        } else {
-          rep.has_c = true;
-          rep.right.updates = {{"all", e.updates(Side::right)}};
-          rep.left.updates = {{"all", e.updates(Side::left)}};
-          if constexpr (std::is_same_v<E, CoupledCartsEstimator>) {
-            rep.has_shared_d = true;
-            rep.d = e.deadband();
-            rep.d_reason = e.deadband_reason();
-            rep.d_updates = {{"+", e.deadband_updates(true)}, {"-", e.deadband_updates(false)}};
-          }
+        auto counts = [&](Side s) -> std::vector<std::pair<std::string, std::uint64_t>> {
+          if constexpr (E::traits.keys_by_direction) return {{"+", e.updates(s, true)}, {"-", e.updates(s, false)}};
+          return {{"all", e.updates(s)}};
+        };
+        rep.right.updates = counts(Side::right);
+        if constexpr (E::traits.two_sided) rep.left.updates = counts(Side::left);
+        if constexpr (E::traits.has_shared_d) {
+          rep.d = e.deadband();
+          rep.d_reason = e.deadband_reason();
+          rep.d_updates = {{"+", e.deadband_updates(true)}, {"-", e.deadband_updates(false)}};
         }
       },
       e_);

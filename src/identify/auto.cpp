@@ -16,30 +16,8 @@ namespace lash {
 
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kRateShare = 0.10;  // dead band on ẏ as a share of the output's typical rate (docs)
 
-bool uses_guesses(ModelKind m) noexcept { return contains(InputSwitchingSettings::models, m); }
-
-/// The deadzone edge a side's regression points at, identified or not (NaN when there is none).
-double raw_edge(const AnyEstimator& est, Side s) {
-  const SideParams p = est.params(s);
-  if (p.identified && std::isfinite(p.c)) return p.c;
-  if (const auto* e = est.get<DeadzoneDeadbandEstimator>()) {
-    if (est.config().pooled) {
-      if (e->updates(s, true) + e->updates(s, false) < est.config().min_updates) return kNaN;
-      const auto& eta = e->pooled_rls(s).eta();
-      return std::fabs(eta[1]) > 1e-12 ? -eta[2] / eta[1] : kNaN;
-    }
-    return kNaN;
-  }
-  if (const auto* e = est.get<InputDeadzoneEstimator>()) {
-    if (e->updates(s) < est.config().min_updates) return kNaN;
-    const auto& eta = e->rls(s).eta();
-    return std::fabs(eta[1]) > 1e-12 ? -eta[2] / eta[1] : kNaN;
-  }
-  return kNaN;
-}
+bool uses_guesses(ModelKind m) noexcept { return model_traits(m).uses_guesses; }
 
 /// One order statistic of a sequence seen once, exactly, in bounded memory (Floyd & Rivest's
 /// selection, as median_step in io/table.cpp): a bracket [lo, hi] from a small sample of the
@@ -348,63 +326,10 @@ DataTraits analyse_record(std::span<const double> v, std::span<const double> y, 
   return d;
 }
 
-// E3, E4 below: the thesis's experiments, defined in docs/method.md §A7.
+// Each model's choices are its policy's tune() (identify/models/; E3–E5: docs/method.md §A7).
 void tune_to_data(EstimatorConfig& c, const DataTraits& d) {
   c.dt_s = d.dt_s > 0.0 ? d.dt_s : c.dt_s;
-  switch (c.model) {
-    case ModelKind::deadzone_deadband: {
-      // Dead band on ẏ: 3σ of the derivative filter's noise output (||h||₂ of
-      // MA20 ∘ difference/T ∘ MA40 on white noise of the record's σ), and at least one
-      // encoder step per derivative window.
-      const double m = static_cast<double>(c.noise.filter_length);
-      const double m2 = static_cast<double>(c.noise.derivative_filter_length);
-      // h = MA_m2 * (δ − δ₁)/T * MA_m: its taps are (box_m − box_m shifted by 1)/(m·m2·T) summed
-      // m2 times; the difference of two boxes shifted by 1..m2 has 2·min(j, m) nonzero taps.
-      double h2 = 0.0;
-      {
-        // exact ||h||² from the taps, computed on a small buffer
-        const auto L = static_cast<std::size_t>(m + m2 + 1);
-        std::vector<double> box(L, 0.0), h(L, 0.0);
-        for (std::size_t i = 0; i < static_cast<std::size_t>(m); ++i) box[i] = 1.0 / m;
-        for (std::size_t j = 0; j < static_cast<std::size_t>(m2); ++j)
-          for (std::size_t i = 0; i + 1 < L; ++i) {
-            if (i + j < L) h[i + j] += box[i] / (m2 * c.dt_s);
-            if (i + j + 1 < L) h[i + j + 1] -= box[i] / (m2 * c.dt_s);
-          }
-        for (double x : h) h2 += x * x;
-      }
-      const double noise = 3.0 * d.noise_sigma * std::sqrt(h2);
-      const double quant = d.quantum > 0.0 ? d.quantum / (m2 * c.dt_s) : 0.0;
-      c.noise.derivative_threshold = std::max({noise, quant, kRateShare * d.ydot_p90});
-      break;
-    }
-    case ModelKind::output_deadzone:
-    case ModelKind::linear:
-      // a memory of 2 s: several time constants of a mechanical axis and a few reversals (E3 and
-      // EMPS at 1 kHz: λ = 0.9995; 10 s followed closed-loop noise less well on EMPS)
-      c.rls.lambda = std::clamp(1.0 - c.dt_s / 2.0, 0.99, 0.99995);
-      break;
-    case ModelKind::coupled_carts:
-      // a quantised position (linear scale) gives a quantised velocity: average it over 1000 samples
-      if (d.quantum > 0.0) c.rls.lambda = 0.999;
-      // stage 1 leaves out the pin's impacts: accelerations well above the record's usual ones
-      if (d.yddot_p90 > 0.0) c.accel_limit = 3.0 * d.yddot_p90;
-      break;
-    case ModelKind::input_deadzone: {
-      // Projection box from the record's scales (Goodwin & Sin §3.7): a1 ∈ [−1, 0], 0 < b1 ≤ B and
-      // |e| = |b1·c| ≤ B·max|v|, B = 2·span(y)/span(v) (at least twice the largest static gain the
-      // record can show). Without it a side with few samples (amplitude just above the deadzone)
-      // can run away under forgetting (E4: b1 ~ 1e74).
-      const double vspan = d.v_hi - d.v_lo;
-      if (vspan > 0.0 && d.y_span > 0.0) {
-        const double B = 2.0 * d.y_span / vspan;
-        const double E = B * std::max(std::fabs(d.v_lo), std::fabs(d.v_hi));
-        c.rls.lower = {-1.0, 1e-4 * B, -E};
-        c.rls.upper = {0.0, B, E};
-      }
-      break;
-    }
-  }
+  with_model(c.model, [&]<class Model>() { Model::tune(c, d); });  // identify/models/
 }
 
 AutoRun estimate_auto(const EstimatorConfig& cfg0, std::span<const double> v, std::span<const double> y_raw,
@@ -443,8 +368,8 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, std::span<const double> v, st
   // The edges each side's regression points at are read from the same run's final state (no second pass).
   out.run = run_estimator(cfg, v, y, keep_trace, [&](const AnyEstimator& est) {
     if (!uses_guesses(cfg.model)) return;
-    out.right.edge = raw_edge(est, Side::right);
-    out.left.edge = raw_edge(est, Side::left);
+    out.right.edge = est.raw_edge(Side::right);
+    out.left.edge = est.raw_edge(Side::left);
   }, gap_rows);
   if (uses_guesses(cfg.model)) {
     out.right.guess = cfg.guess_right;
@@ -475,7 +400,7 @@ std::array<double, 2> search_guesses(const EstimatorConfig& cfg0, std::span<cons
     for (int i = 0; i < 2; ++i) {
       const Side s = i == 0 ? Side::right : Side::left;
       const double ext = i == 0 ? hi : lo;   // the input's extreme on this side
-      const double c = raw_edge(est, s);
+      const double c = est.raw_edge(s);
       const double sg = i == 0 ? 1.0 : -1.0;  // outward
       if (!std::isfinite(c)) {
         next[i] = 0.5 * (g[i] + 0.0);       // no data beyond the guess: move it in

@@ -1,5 +1,7 @@
 #include "lash/identify/config.hpp"
 
+#include "lash/identify/estimators.hpp"
+
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -8,24 +10,16 @@
 namespace lash {
 
 ModelKind parse_model_kind(std::string_view n) {
-  if (n == "linear") return ModelKind::linear;
-  if (n == "input-deadzone") return ModelKind::input_deadzone;
-  if (n == "output-deadzone") return ModelKind::output_deadzone;
-  if (n == "deadzone-deadband") return ModelKind::deadzone_deadband;
-  if (n == "coupled-carts") return ModelKind::coupled_carts;
-  throw std::invalid_argument("unknown model '" + std::string(n) +
-                              "' (linear, input-deadzone, output-deadzone, deadzone-deadband, coupled-carts)");
+  std::string names;
+  for (const ModelTraits& t : EstimatorModels::traits) {
+    if (n == t.name) return t.kind;
+    names += (names.empty() ? "" : ", ") + std::string(t.name);
+  }
+  throw std::invalid_argument("unknown model '" + std::string(n) + "' (" + names + ")");
 }
 
 const char* to_string(ModelKind m) noexcept {
-  switch (m) {
-    case ModelKind::linear: return "linear";
-    case ModelKind::input_deadzone: return "input-deadzone";
-    case ModelKind::output_deadzone: return "output-deadzone";
-    case ModelKind::deadzone_deadband: return "deadzone-deadband";
-    case ModelKind::coupled_carts: return "coupled-carts";
-  }
-  return "?";
+  return static_cast<std::size_t>(m) < kModelCount ? model_traits(m).name.data() : "?";
 }
 
 EstimationMethod parse_method(std::string_view n) {
@@ -115,38 +109,9 @@ EstimatorConfig::EstimatorConfig(ModelKind m, double dt) {
   model = m;
   dt_s = dt;
   // lash's data-independent settings per model (docs/identification.md "Defaults chosen from the
-  // data"); the settings that depend on the record come on top (tune_to_data, auto.hpp).
-  // E1–E5 below are the thesis's experiments, defined in docs/method.md §A7.
-  switch (m) {
-    case ModelKind::deadzone_deadband:
-      // E2's method (docs/identification.md "E2: what got how far"): consistent MA40 on v and y,
-      // switching on a filtered derivative with a dead band, direction held over the filter window
-      // (direction_run 41, pooled: the struct's defaults), one pooled 4-parameter regression per
-      // side solved by recursive IV, every sample kept.
-      method = EstimationMethod::iv;
-      iv_delay = 45;
-      rls.lambda = 1.0;
-      noise.filter_length = 40;
-      noise.filter_input = true;
-      noise.derivative_filter_length = 20;
-      noise.derivative_threshold = 150.0;
-      noise.align_delay = 10;
-      break;
-    case ModelKind::input_deadzone:
-      // E4 (lash settings): λ 0.995, a1 ∈ [−1, 0] (stable, non-oscillating first order), b1 ≥ 0.
-      rls.lambda = 0.995;
-      rls.lower = {-1.0, 0.0, -std::numeric_limits<double>::infinity()};
-      rls.upper = {0.0, std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
-      break;
-    case ModelKind::output_deadzone:
-      // E3 (lash settings): directional forgetting; λ from the sample time. No moving average: its
-      // start-up ramp would make a constant input look excited (the verdict reads v over the updates).
-      rls.lambda = 0.9995;
-      rls.forgetting = Forgetting::directional;
-      break;
-    case ModelKind::linear: rls.lambda = 0.9995; break;
-    case ModelKind::coupled_carts: rls.lambda = 0.995; break;  // E5 (lash settings)
-  }
+  // data"), from each model's policy (identify/models/); the settings that depend on the record
+  // come on top (tune_to_data, auto.hpp).
+  with_model(m, [this]<class Model>() { Model::defaults(*this); });
 }
 
 EstimatorConfig EstimatorConfig::thesis(ModelKind m, double dt) {

@@ -42,6 +42,10 @@ struct EstimateReport {
   std::vector<std::pair<std::string, std::uint64_t>> d_updates;
 };
 
+/// Names of the per-step parameter columns of a model ("a1_r", "b1_r", "c_r", "d_r", …; the
+/// linear model's "a1", "b1"), from its traits.
+std::vector<std::string> param_names(const ModelTraits& traits);
+
 class AnyEstimator {
  public:
   /// Validates the config (std::invalid_argument) and builds the estimator of cfg.model.
@@ -78,6 +82,15 @@ class AnyEstimator {
   void restart() noexcept {
     std::visit([](auto& e) noexcept { e.restart(); }, e_);
   }
+  /// Sets side s's switching guess and starts that side's recursion anew (estimator_skeleton.hpp).
+  void set_guess(Side s, double guess) noexcept {
+    std::visit([s, guess](auto& e) noexcept { e.set_guess(s, guess); }, e_);
+    (s == Side::right ? cfg_.guess_right : cfg_.guess_left) = guess;
+  }
+  /// The deadzone edge side s's regression points at, identified or not (NaN when none).
+  double raw_edge(Side s) const noexcept {
+    return std::visit([s](const auto& e) noexcept { return e.raw_edge(s); }, e_);
+  }
   /// Back to the state right after construction. Not real-time safe.
   void reset() {
     std::visit([](auto& e) { e.reset(); }, e_);
@@ -102,10 +115,17 @@ class AnyEstimator {
   }
 
  private:
+  template <class List>
+  struct VariantOf;
+  template <class... M>
+  struct VariantOf<ModelList<M...>> {
+    using type = std::variant<SwitchingEstimator<M>...>;
+  };
+  using Variant = VariantOf<EstimatorModels>::type;  // one alternative per registered model
+  static Variant make(const EstimatorConfig& cfg);
+
   EstimatorConfig cfg_;
-  std::variant<LinearEstimator, InputDeadzoneEstimator, OutputDeadzoneEstimator, DeadzoneDeadbandEstimator,
-               CoupledCartsEstimator>
-      e_;
+  Variant e_;
   std::uint64_t samples_ = 0;
 };
 

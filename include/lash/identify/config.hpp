@@ -14,7 +14,10 @@
 
 namespace lash {
 
+/// The models of docs/method.md §A4. Each has its policy and traits under identify/models/,
+/// registered in EstimatorModels (estimators.hpp), where names, parameters and defaults come from.
 enum class ModelKind : std::uint8_t { linear, input_deadzone, output_deadzone, deadzone_deadband, coupled_carts };
+inline constexpr std::size_t kModelCount = 5;
 
 /// "linear", "input-deadzone", "output-deadzone", "deadzone-deadband", "coupled-carts";
 /// throws std::invalid_argument otherwise.
@@ -53,7 +56,7 @@ struct RlsSettings {
 /// A set of models (bit i = ModelKind i): which models read a settings struct.
 using ModelSet = std::uint8_t;
 constexpr ModelSet model_bit(ModelKind m) noexcept { return static_cast<ModelSet>(1u << static_cast<unsigned>(m)); }
-constexpr ModelSet kAllModels = 0x1f;
+constexpr ModelSet kAllModels = static_cast<ModelSet>((1u << kModelCount) - 1);
 constexpr bool contains(ModelSet set, ModelKind m) noexcept { return (set & model_bit(m)) != 0; }
 
 /// The moving averages on the regression signals (every model).
