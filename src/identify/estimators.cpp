@@ -176,6 +176,14 @@ void InputDeadzoneEstimator::refresh(Side s) noexcept {
   TwoSideEstimator::refresh(s, c, c > cfg_.guess_left && c < cfg_.guess_right);
 }
 
+void InputDeadzoneEstimator::set_guess(Side s, double guess) noexcept {
+  (s == Side::right ? cfg_.guess_right : cfg_.guess_left) = guess;
+  rls_[s].reset();
+  p_[s] = SideParams{};
+  vrange_[s] = {};
+  yrange_[s] = {};
+}
+
 double InputDeadzoneEstimator::step(double v, double y) noexcept {
   if (!finite_all(v, y)) [[unlikely]] {
     ++skipped_;
@@ -273,6 +281,20 @@ void DeadzoneDeadbandEstimator::restart() noexcept {
   regime1_ = 0;
   run_ = 0;
   warm_ = warmup_;
+}
+
+void DeadzoneDeadbandEstimator::set_guess(Side s, double guess) noexcept {
+  (s == Side::right ? cfg_.guess_right : cfg_.guess_left) = guess;
+  for (const bool plus : {true, false}) {
+    rls_[key(s, plus)].reset();
+    count_[key(s, plus)] = 0;
+  }
+  pooled_[s].reset();
+  usable_[s] = false;
+  settled_[s] = since_[s] = 0;
+  prev_c_[s] = prev_d_[s] = 0.0;
+  vrange_[s] = {};
+  yrange_[s] = {};
 }
 
 // simulate() and predict_free() run on every sample: defined here, before step(), and inlined

@@ -180,6 +180,11 @@ class InputDeadzoneEstimator : public detail::TwoSideEstimator {
  public:
   explicit InputDeadzoneEstimator(const EstimatorConfig& cfg);
   double step(double v, double y) noexcept;
+  /// Online re-guessing (identify/reguess.hpp): sets side s's switching guess (guess_right or
+  /// guess_left of the config) and restarts only that side's recursion — its RLS (estimate,
+  /// covariance, update count) and its verdict evidence; the other side, the signal history and
+  /// the free-run model are untouched. noexcept, O(1), allocation-free.
+  void set_guess(Side s, double guess) noexcept;
   void reset() { *this = InputDeadzoneEstimator(cfg_); }
 
  private:
@@ -215,6 +220,11 @@ class DeadzoneDeadbandEstimator {
 
   explicit DeadzoneDeadbandEstimator(const EstimatorConfig& cfg);
   double step(double v, double y) noexcept;
+  /// Online re-guessing (identify/reguess.hpp): sets side s's switching guess (guess_right or
+  /// guess_left of the config) and restarts only that side's recursion — its RLS (estimate,
+  /// covariance, update count) and its verdict evidence; the other side, the signal history and
+  /// the free-run model are untouched. noexcept, O(1), allocation-free.
+  void set_guess(Side s, double guess) noexcept;
   void reset() { *this = DeadzoneDeadbandEstimator(cfg_); }
   /// After a gap: clears the signal history, keeps the estimates (see the file comment).
   void restart() noexcept;
