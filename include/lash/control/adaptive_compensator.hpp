@@ -76,8 +76,8 @@ struct AdaptationSettings {
 /// transient after a change) and starts again on the level it finds.
 struct DriftDetectSettings {
   bool enabled = true;
-  double allowance_ratio = 0.05;  ///< δ / nominal [-], > 0
-  double delay_s = 0.5;           ///< a change of 2δ alarms after this long [s], > 0
+  double allowance_ratio = 0.1;   ///< δ / nominal [-], > 0
+  double delay_s = 0.25;          ///< a change of 2δ alarms after this long [s], > 0
   double warmup_s = 5.0;          ///< adapting time of a side before its test starts [s], >= 0
   double rearm_s = 2.0;           ///< adapting time after an alarm before the test restarts [s], >= 0
   /// Throws std::invalid_argument naming the field.
