@@ -1,6 +1,6 @@
 #pragma once
 /// @file reguess.hpp
-/// Online re-guessing of a switching guess (docs/method.md §A4.7): the input-side estimators
+/// Online re-guessing of a switching guess (docs/method.md §A4.8): the input-side estimators
 /// (input-deadzone, deadzone-deadband) update a side only where v(k−1) lies beyond that side's
 /// guess c*, and the guess must lie outside the deadzone (eq. 18). Offline, `lash estimate`
 /// searches the guesses by a fixed-point iteration over the whole record
@@ -30,7 +30,7 @@
 /// (InputDeadzoneEstimator::set_guess, DeadzoneDeadbandEstimator::set_guess); the evidence starts
 /// again, and the in rule waits `memory_s` before it may fire.
 ///
-/// Why it converges and never oscillates (docs/method.md §A4.7): once g lies beyond the true
+/// Why it converges and never oscillates (docs/method.md §A4.8): once g lies beyond the true
 /// edge c, every update obeys the side's linear relation, ĉ ≈ c < g and `wrong_guess` cannot
 /// persist, so the out rule stops; the in rule's target b + 0.15·(x_max − b) with b = ĉ ≈ c
 /// lies outside the deadzone and receives a fixed share of the samples beyond ĉ (a sine with
