@@ -85,9 +85,9 @@ bool SideReguess::step(double v1, bool updated, Reason reason, double edge) noex
   // lies in the top of its reach
   if (since_move_ >= kBlocks * window_n_ && std::isfinite(e) && beyond_ >= s_.min_beyond) {
     const double b = e > floor_ ? e : floor_;
-    const double xmax = this->xmax();
-    if (xmax > b && g_ > b + s_.reach_fraction * (xmax - b)) {
-      const double to = b + s_.margin_fraction * (xmax - b);
+    const double reach = xmax();
+    if (reach > b && g_ > b + s_.reach_fraction * (reach - b)) {
+      const double to = b + s_.margin_fraction * (reach - b);
       if (to < g_) return move(to, ReguessRule::in);
     }
   }
