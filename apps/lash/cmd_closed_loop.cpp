@@ -245,7 +245,7 @@ Command add_closed_loop(CLI::App& app) {
                 "estimate, on the virtual pilot-valve rig and on B1 + a second pole");
   sub->add_option("--scenario", o->scenario,
                   "Closed-loop scenario TOML with a drifting rig (docs/compensation.md); the step options are ignored");
-  sub->add_option("--compensation", o->compensation, "With --scenario: none | fixed | adaptive (default adaptive)");
+  sub->add_option("--compensation", o->compensation, "With --scenario: none | fixed | adaptive | oracle (default adaptive; oracle: the inverse fed the plant's true current parameters)");
   sub->add_option("-o,--output", o->out, "Write both traces as CSV");
   sub->add_option("--plot", o->plot, "Also render a PNG (needs -o)");
   add_controller_options(sub, o->controller, true);

@@ -86,14 +86,38 @@ int run_closed_loop_scenario_cmd(const std::string& path, const std::string& com
                        {"estimator_identified", r.estimator_identified},
                        {"estimator_reason", r.estimator_reason},
                        {"dither_amplitude", s.adaptation.dither_amplitude},
-                       {"dither_period_s", s.adaptation.dither_period_s}};
+                       {"dither_period_s", s.adaptation.dither_period_s},
+                       {"reguesses", {{"right", r.reguesses_right}, {"left", r.reguesses_left}}}};
     // The estimator inside the adaptive compensator and its excitation settings (docs/compensation.md).
     const EstimatorConfig& e = valve ? s.estimator : s.backlash_estimator;
     j["adaptation"]["estimator"] = {{"model", to_string(e.model)},
                                     {"lambda", e.rls.lambda},
                                     {"forgetting", to_string(e.rls.forgetting)},
                                     {"guess_right", e.guess_right},
-                                    {"guess_left", e.guess_left}};
+                                    {"guess_left", e.guess_left},
+                                    {"reguess", s.reguess.enabled}};
+    {
+      // re-guesses and drift events: valve edges [mA], carts gaps [m]; a re-guess's values are the
+      // estimator's guesses (carts: on the shifted input w +- s [m])
+      nlohmann::json ev = nlohmann::json::array();
+      for (std::uint32_t i = 0; i < r.events.n; ++i) {
+        const AdaptationEvent& ae = r.events.events[i];
+        const bool drift = ae.kind == AdaptationEvent::Kind::drift;
+        nlohmann::json x = {{"kind", to_string(ae.kind)},
+                            {"t_s", static_cast<double>(ae.sample) * s.dt_s},
+                            {"parameter", std::string(drift ? (valve ? "edge_" : "deadband_") : "guess_") +
+                                              (ae.side == Side::right ? "right" : "left")},
+                            {"old", num(ae.old_value)},
+                            {"new", num(ae.new_value)},
+                            {"size", num(ae.new_value - ae.old_value)}};
+        if (!drift) x["rule"] = to_string(ae.rule);
+        ev.push_back(std::move(x));
+      }
+      j["adaptation"]["events"] = std::move(ev);
+      j["adaptation"]["events_dropped"] = r.events.dropped;
+    }
+    if (mode == CompensationMode::adaptive)
+      j["adaptation"]["estimator"]["final_guess"] = {{"right", r.guess_right}, {"left", r.guess_left}};
     if (!valve) j["adaptation"]["estimator"]["input_shift"] = s.backlash_estimator.input_shift;
     if (r.bench) {  // valve: the bench's figures before and after the first drift too
       const auto b = nlohmann::json::parse(hil::scenario_json(*r.bench));
@@ -108,8 +132,23 @@ int run_closed_loop_scenario_cmd(const std::string& path, const std::string& com
              r.rms_error, unit, r.max_abs_error, unit);
   fmt::print("inverse at the end: right {:.6g} {}, left {:.6g} {}; {} parameter updates\n", r.final_right, punit,
              r.final_left, punit, r.updates);
-  if (mode == CompensationMode::adaptive)
+  if (mode == CompensationMode::adaptive) {
     fmt::print("adaptation: {} (estimator: {})\n", to_string(r.reason), r.estimator_reason);
+    fmt::print("re-guesses: right {}, left {}; guesses at the end: right {:.6g} {}, left {:.6g} {}\n",
+               r.reguesses_right, r.reguesses_left, r.guess_right, punit, r.guess_left, punit);
+  }
+  for (std::uint32_t i = 0; i < r.events.n; ++i) {
+    const AdaptationEvent& e = r.events.events[i];
+    const char* side = e.side == Side::right ? "right" : "left";
+    if (e.kind == AdaptationEvent::Kind::drift)
+      fmt::print("  {:8.3f} s drift of the {} {}: {:.6g} -> {:.6g} {} (size {:+.6g})\n",
+                 static_cast<double>(e.sample) * s.dt_s, side, valve ? "edge" : "deadband", e.old_value,
+                 e.new_value, punit, e.new_value - e.old_value);
+    else
+      fmt::print("  {:8.3f} s re-guess ({}) of the {} guess: {:.6g} -> {:.6g}\n",
+                 static_cast<double>(e.sample) * s.dt_s, to_string(e.rule), side, e.old_value, e.new_value);
+  }
+  if (r.events.dropped > 0) fmt::print("  ({} more events not recorded)\n", r.events.dropped);
   if (!complete) {
     fmt::print("figures incomplete: {}\n", why);
     return kExitFailed;

@@ -57,7 +57,8 @@ def estimate(t: ArrayLike, v: ArrayLike, y: ArrayLike, *, model: str = "deadzone
 
 class Estimator:
     """One estimator fed sample by sample; the k-th sample is at t = k*dt_s [s]."""
-    def __init__(self, model: str, dt_s: float, *, preset: str = "thesis", **settings: Any) -> None: ...
+    def __init__(self, model: str, dt_s: float, *, preset: str = "thesis", reguess: bool = False,
+                 **settings: Any) -> None: ...
     def update(self, v: float, y: float) -> float:
         """One sample; returns the one-step prediction yhat [output unit]."""
     def update_many(self, v: ArrayLike, y: ArrayLike) -> npt.NDArray[np.float64]:
@@ -70,6 +71,12 @@ class Estimator:
     def dt_s(self) -> float: ...
     @property
     def identified(self) -> bool: ...
+    @property
+    def reguesses(self) -> dict[str, int]:
+        """Moves of each side's switching guess so far (reguess=True; docs/method.md A4.8)."""
+    @property
+    def guesses(self) -> dict[str, float]:
+        """Each side's switching guess now [input unit]."""
     def params(self) -> dict[str, float]:
         """Current parameters by name (a1_r, b1_r, c_r, d_r, ...; NaN = not identified)."""
 

@@ -12,6 +12,7 @@
 #include "lash/identify/data.hpp"
 #include "lash/identify/estimate.hpp"
 #include "lash/identify/estimate_report.hpp"
+#include "lash/identify/reguess.hpp"
 #include "lash/io/error.hpp"
 
 namespace lash::py {
@@ -47,11 +48,19 @@ class Estimator {
  public:
   Estimator(const std::string& model, double dt_s, const std::string& preset, const pyb::kwargs& settings) {
     if (!(dt_s > 0) || !std::isfinite(dt_s)) throw InputError("", 0, "dt", "must be a finite number > 0 [s]");
-    const toml::table tbl = to_toml(settings);
+    // reguess=True: online re-guessing of the switching guesses (identify/reguess.hpp); not a
+    // config-file key, so taken out before the settings are read
+    pyb::dict rest;
+    for (const auto& kv : settings) {
+      if (pyb::str(kv.first).cast<std::string>() == "reguess") reguess_ = kv.second.cast<bool>();
+      else rest[kv.first] = kv.second;
+    }
+    const toml::table tbl = to_toml(rest);
     EstimateSettings set = resolve_settings(sources(model, preset, tbl), dt_s);
     cfg_ = set.cfg;
     job_ = set.job;
     est_ = std::make_unique<AnyEstimator>(cfg_);
+    make_reguesser();
   }
 
   double update(double v, double y, std::optional<double> t_s) {
@@ -91,6 +100,7 @@ class Estimator {
 
   void reset() {
     est_ = std::make_unique<AnyEstimator>(cfg_);
+    make_reguesser();
     t_.clear();
     v_.clear();
     y_.clear();
@@ -108,8 +118,25 @@ class Estimator {
     return d;
   }
   bool identified() const noexcept { return est_->identified(); }
+  pyb::dict reguesses() const {
+    pyb::dict d;
+    d["right"] = rg_ ? rg_->count(Side::right) : 0;
+    d["left"] = rg_ ? rg_->count(Side::left) : 0;
+    return d;
+  }
+  pyb::dict guesses() const {
+    pyb::dict d;
+    d["right"] = rg_ ? rg_->guess(Side::right) : cfg_.guess_right;
+    d["left"] = rg_ ? rg_->guess(Side::left) : cfg_.guess_left;
+    return d;
+  }
 
  private:
+  void make_reguesser() {
+    rg_.reset();
+    vprev_ = 0.0;
+    if (reguess_) rg_.emplace(cfg_.guess_right, cfg_.guess_left, ReguessSettings{}, cfg_.dt_s);
+  }
   void reserve(std::size_t more) {
     t_.reserve(t_.size() + more);
     v_.reserve(v_.size() + more);
@@ -124,12 +151,21 @@ class Estimator {
     v_.push_back(v);
     y_.push_back(y);
     yhat_ = est_->step(v, y);
+    if (rg_) {  // the input-side models only (set_guess); the others have no guesses
+      est_->visit_steps(0, [&](auto& e) {
+        if constexpr (requires { e.set_guess(Side::right, 0.0); }) rg_->follow(e, vprev_);
+      });
+    }
+    vprev_ = v;
     ysim_.push_back(est_->simulated());
   }
 
   EstimatorConfig cfg_;
   EstimationJob job_;
   std::unique_ptr<AnyEstimator> est_;
+  bool reguess_ = false;
+  std::optional<Reguesser> rg_;
+  double vprev_ = 0.0;
   std::vector<double> t_, v_, y_, ysim_;
   double yhat_ = 0.0;
 };
@@ -227,7 +263,8 @@ void bind_estimate(pyb::module_& m) {
                          "Estimator(model, dt_s, *, preset='thesis', **settings): one estimator fed sample by sample\n"
                          "(streaming): the preset's static settings (nothing is chosen from data not seen yet), no\n"
                          "guess search, no outlier gate. dt_s: sample period [s]; settings as for lash.estimate.\n"
-                         "The k-th sample is at t = k*dt_s.")
+                         "The k-th sample is at t = k*dt_s. reguess=True: the switching guesses follow the\n"
+                         "evidence online (docs/method.md A4.8; input-deadzone and deadzone-deadband).")
       .def(pyb::init<const std::string&, double, const std::string&, const pyb::kwargs&>(), pyb::arg("model"),
            pyb::arg("dt_s"), pyb::kw_only(), pyb::arg("preset") = "thesis")
       .def("update", &Estimator::update, pyb::arg("v"), pyb::arg("y"), pyb::arg("t_s") = pyb::none(),
@@ -243,6 +280,8 @@ void bind_estimate(pyb::module_& m) {
       .def_property_readonly("samples", &Estimator::samples, "Samples fed so far.")
       .def_property_readonly("dt_s", &Estimator::dt_s, "Sample period [s].")
       .def_property_readonly("identified", &Estimator::identified, "The estimator's verdict now.")
+      .def_property_readonly("reguesses", &Estimator::reguesses, "Moves of each side's guess so far (reguess=True).")
+      .def_property_readonly("guesses", &Estimator::guesses, "Each side's switching guess now [input unit].")
       .def("params", &Estimator::params, "Current parameters by name (a1_r, b1_r, c_r, d_r, ...; NaN = not identified).");
 
   m.def("read_record", &read_record, pyb::arg("path"), pyb::arg("columns") = std::vector<std::string>{"t", "v", "y"},

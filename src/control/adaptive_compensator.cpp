@@ -21,7 +21,8 @@ CompensationMode parse_compensation_mode(const char* text) {
   if (std::strcmp(text, "none") == 0) return CompensationMode::none;
   if (std::strcmp(text, "fixed") == 0) return CompensationMode::fixed;
   if (std::strcmp(text, "adaptive") == 0) return CompensationMode::adaptive;
-  throw std::invalid_argument(std::string("compensation must be none, fixed or adaptive, not '") + text + "'");
+  if (std::strcmp(text, "oracle") == 0) return CompensationMode::oracle;
+  throw std::invalid_argument(std::string("compensation must be none, fixed, adaptive or oracle, not '") + text + "'");
 }
 
 const char* to_string(CompensationMode m) noexcept {
@@ -29,8 +30,20 @@ const char* to_string(CompensationMode m) noexcept {
     case CompensationMode::none: return "none";
     case CompensationMode::fixed: return "fixed";
     case CompensationMode::adaptive: return "adaptive";
+    case CompensationMode::oracle: return "oracle";
   }
   return "?";
+}
+
+void DriftDetectSettings::validate() const {
+  require(std::isfinite(allowance_ratio) && allowance_ratio > 0, "drift detection allowance_ratio must be > 0");
+  require(std::isfinite(delay_s) && delay_s > 0, "drift detection delay_s must be > 0 [s]");
+  require(std::isfinite(warmup_s) && warmup_s >= 0 && warmup_s < 1e9, "drift detection warmup_s must be >= 0 [s]");
+  require(std::isfinite(rearm_s) && rearm_s >= 0 && rearm_s < 1e9, "drift detection rearm_s must be >= 0 [s]");
+}
+
+const char* to_string(AdaptationEvent::Kind k) noexcept {
+  return k == AdaptationEvent::Kind::reguess ? "reguess" : "drift";
 }
 
 const char* to_string(AdaptationReason r) noexcept {
@@ -148,22 +161,34 @@ DeadzoneAdapter::DeadzoneAdapter(const CompensationConfig<DeadzoneAdapter>& c)
     : est_(c.estimator),
       ecfg_(c.estimator),
       need_{c.adaptation.min_excitation_ratio * c.nominal.offset_right,
-            c.adaptation.min_excitation_ratio * c.nominal.offset_left} {
-  exc_r_.lambda = exc_l_.lambda = c.estimator.rls.lambda;
+            c.adaptation.min_excitation_ratio * c.nominal.offset_left},
+      rg_(c.estimator.guess_right, c.estimator.guess_left, c.reguess, c.estimator.dt_s) {
+  exc_.right.lambda = exc_.left.lambda = c.estimator.rls.lambda;
 }
 
-PerSide<GateInput> DeadzoneAdapter::step(double v_applied, double y) noexcept {
+PerSide<GateInput> DeadzoneAdapter::step(double v_applied, double y, const PerSide<double>& in_use) noexcept {
   // The estimator's switching: v(k−1) beyond the guesses (the excitation record follows it).
   const double v1 = v1_;
   v1_ = v_applied;
   est_.step(v_applied, y);
   if (!est_.warming_up()) {
-    if (v1 > ecfg_.guess_right) exc_r_.add(v1);
-    else if (v1 < ecfg_.guess_left) exc_l_.add(v1);
+    if (v1 > ecfg_.guess_right) exc_.right.add(v1);
+    else if (v1 < ecfg_.guess_left) exc_.left.add(v1);
+  }
+  // Re-guessing (identify/reguess.hpp) on the inverse's edges: a move sets the estimator's guess
+  // (restarting that side's recursion) and starts that side's excitation record again.
+  const PerSide<bool> moved = rg_.follow(est_, v1, {in_use.right, -in_use.left});
+  for (const Side s : {Side::right, Side::left}) {
+    if (!moved[s]) [[likely]]
+      continue;
+    (s == Side::right ? ecfg_.guess_right : ecfg_.guess_left) = rg_.guess(s);
+    const double lambda = exc_[s].lambda;
+    exc_[s] = detail::Excitation{};
+    exc_[s].lambda = lambda;
   }
   const SideParams r = est_.params(Side::right), l = est_.params(Side::left);
-  const bool ex_r = exc_r_.var >= need_.right * need_.right;  // std ≥ need, without a square root
-  const bool ex_l = exc_l_.var >= need_.left * need_.left;
+  const bool ex_r = exc_.right.var >= need_.right * need_.right;  // std ≥ need, without a square root
+  const bool ex_l = exc_.left.var >= need_.left * need_.left;
   not_excited_.right = r.identified && !ex_r;
   not_excited_.left = l.identified && !ex_l;
   return {{r.identified && ex_r, r.c}, {l.identified && ex_l, -l.c}};

@@ -90,6 +90,7 @@ void read_compensation(TomlTable& c, ClosedLoopScenario& s) {
   a.dither_period_s = c.number_or("dither_period_s", a.dither_period_s);
   a.min_excitation_ratio = c.number_or("min_excitation_ratio", a.min_excitation_ratio);
   a.tolerance_ratio = c.number_or("tolerance_ratio", a.tolerance_ratio);
+  if (auto rg = c.boolean_opt("reguess")) s.reguess.enabled = *rg;
   try {
     a.validate();
   } catch (const std::invalid_argument& e) {
@@ -182,16 +183,27 @@ ClosedLoopScenario load_closed_loop_scenario(const std::filesystem::path& path) 
   }
   s.estimator = default_estimator(s);
   s.backlash_estimator = default_backlash_estimator(s);
+  // Re-guessing (identify/reguess.hpp) is on for the valve. The carts' estimator sees the known
+  // input shift: its edges sit at ±s + (c_r − c_l')/2 whatever the clearance, so the guesses
+  // ±1.5 s stay outside them; its 8 s reference period is also longer than the in rule's memory.
+  s.reguess.enabled = s.rig == rigs::RigKind::pilot_valve;
   // Drifts: each key is checked by the rig reader itself (unknown keys, invalid values).
   rigs::RigConfig current = s.rig_config;
-  double last_at = -1.0;
+  double last_at = -1.0, last_end = -1.0;
   for (TomlTable& d : t.tables("drift")) {
     Drift e;
     e.at_s = d.number("at_s");
     if (!(e.at_s > 0 && e.at_s < s.duration_s))
       d.fail("at_s", "must lie inside the run: 0 < at_s < duration_s = " + std::to_string(s.duration_s) + " s");
     if (e.at_s < last_at) d.fail("at_s", "drifts must be in time order");
+    if (e.at_s < last_end)
+      d.fail("at_s", "a drift starts after the previous ramp ended (at " + std::to_string(last_end) + " s)");
+    e.ramp_s = d.number_or("ramp_s", 0.0);
+    if (!(e.ramp_s >= 0 && e.at_s + e.ramp_s <= s.duration_s))
+      d.fail("ramp_s", "must be >= 0 [s] and end inside the run (at_s + ramp_s <= duration_s = " +
+                           std::to_string(s.duration_s) + " s)");
     last_at = e.at_s;
+    last_end = e.ramp_s > 0 ? e.at_s + e.ramp_s : -1.0;
     e.param = d.string("param");
     e.value = d.number("value");
     if (s.rig == rigs::RigKind::coupled_carts && e.param != "free_mass_kg" && e.param != "free_coulomb_N" &&
@@ -209,6 +221,7 @@ ClosedLoopScenario load_closed_loop_scenario(const std::filesystem::path& path) 
     } catch (const InputError& ex) {
       d.fail("param", "drift of '" + e.param + "' to " + std::to_string(e.value) + ": " + ex.message());
     }
+    e.before = current;
     current = e.after;
     d.finish();
     s.drift.push_back(std::move(e));
@@ -255,6 +268,38 @@ namespace {
 
 double clamp(double x, double lo, double hi) noexcept { return x < lo ? lo : (x > hi ? hi : x); }
 
+// A ramp's rig: every real-valued parameter moved the share f of the way (only the drifted one
+// differs between a and b; x + (x − x)·f = x exactly for the others; f = 1 gives b exactly).
+double lerp(double a, double b, double f) noexcept { return f >= 1.0 ? b : a + (b - a) * f; }
+rigs::PilotValveRigParams lerp(const rigs::PilotValveRigParams& a, const rigs::PilotValveRigParams& b, double f) noexcept {
+  rigs::PilotValveRigParams p = a;
+  for (double rigs::PilotValveRigParams::*m :
+       {&rigs::PilotValveRigParams::deadzone_right_mA, &rigs::PilotValveRigParams::deadzone_left_mA,
+        &rigs::PilotValveRigParams::gain_right_kPa_mA, &rigs::PilotValveRigParams::gain_left_kPa_mA,
+        &rigs::PilotValveRigParams::tau0_s, &rigs::PilotValveRigParams::tau_half_pressure_kPa,
+        &rigs::PilotValveRigParams::solenoid_tau_s, &rigs::PilotValveRigParams::bias_kPa,
+        &rigs::PilotValveRigParams::noise_sigma_kPa, &rigs::PilotValveRigParams::quantum_kPa})
+    p.*m = lerp(a.*m, b.*m, f);
+  return p;
+}
+rigs::CoupledCartsParams lerp(const rigs::CoupledCartsParams& a, const rigs::CoupledCartsParams& b, double f) noexcept {
+  rigs::CoupledCartsParams p = a;
+  for (double rigs::CoupledCartsParams::*m :
+       {&rigs::CoupledCartsParams::free_mass_kg, &rigs::CoupledCartsParams::free_coulomb_N,
+        &rigs::CoupledCartsParams::free_static_N, &rigs::CoupledCartsParams::half_clearance_m,
+        &rigs::CoupledCartsParams::restitution, &rigs::CoupledCartsParams::lock_speed_m_s})
+    p.*m = lerp(a.*m, b.*m, f);
+  return p;
+}
+rigs::RigConfig lerp(const rigs::RigConfig& a, const rigs::RigConfig& b, double f) {
+  rigs::RigConfig c = b;
+  c.pilot_valve = lerp(a.pilot_valve, b.pilot_valve, f);
+  c.coupled_carts = lerp(a.coupled_carts, b.coupled_carts, f);
+  return c;
+}
+// A drift's first sample and its length in samples (0 = a step).
+std::int64_t ramp_n(const Drift& d, double dt_s) { return std::llround(d.ramp_s / dt_s); }
+
 
 // RMS and max of r − y over a window, sample by sample: the arithmetic of hil::tracking (the same
 // bits), without keeping the samples.
@@ -286,6 +331,11 @@ void finish(ClosedLoopScenarioResult& res, const Comp& comp) {
   res.final_right = used.right;
   res.final_left = used.left;
   res.updates = comp.updates();
+  res.reguesses_right = comp.adapter().reguesses(Side::right);
+  res.reguesses_left = comp.adapter().reguesses(Side::left);
+  res.guess_right = comp.adapter().guess(Side::right);
+  res.guess_left = comp.adapter().guess(Side::left);
+  res.events = comp.events();
   res.reason = comp.reason();
   res.estimator_identified = comp.adapter().identified(Side::right) && comp.adapter().identified(Side::left);
   res.estimator_reason = std::string("right: ") + comp.estimator_reason(Side::right) +
@@ -293,6 +343,20 @@ void finish(ClosedLoopScenarioResult& res, const Comp& comp) {
 }
 
 }  // namespace
+
+rigs::RigConfig rig_config_at(const ClosedLoopScenario& s, std::int64_t k) {
+  rigs::RigConfig c = s.rig_config;
+  for (const Drift& d : s.drift) {
+    const std::int64_t k0 = step_of(d.at_s, s.dt_s), n = ramp_n(d, s.dt_s);
+    if (k < k0) break;
+    if (n == 0 || k >= k0 + n) {
+      c = d.after;
+      continue;
+    }
+    return lerp(d.before, d.after, static_cast<double>(k - k0) / static_cast<double>(n));
+  }
+  return c;
+}
 
 void apply_to_bench(const ClosedLoopScenario& s, CompensationMode mode, hil::BenchSettings& b) {
   if (s.rig != rigs::RigKind::pilot_valve)
@@ -309,8 +373,13 @@ void apply_to_bench(const ClosedLoopScenario& s, CompensationMode mode, hil::Ben
   h.mode = mode;
   h.plant.params = s.rig_config.pilot_valve;
   h.plant.seed = s.seed;
-  for (const Drift& d : s.drift)
-    h.plant.drift.push_back({static_cast<std::uint32_t>(step_of(d.at_s, s.dt_s)), d.after.pilot_valve});
+  // A ramp moves the rig once per control step (its changes at k0 + 1 … k0 + n; k0 is the value
+  // before): the slave's drift list holds n entries for it.
+  for (const Drift& d : s.drift) {
+    const std::int64_t k0 = step_of(d.at_s, s.dt_s), n = ramp_n(d, s.dt_s);
+    for (std::int64_t k = n == 0 ? k0 : k0 + 1; k <= k0 + n; ++k)
+      h.plant.drift.push_back({static_cast<std::uint32_t>(k), rig_config_at(s, k).pilot_valve});
+  }
   h.law.pid = s.pid;
   h.law.pid.dt_s = s.dt_s;
   h.law.feedforward = s.feedforward;
@@ -320,6 +389,12 @@ void apply_to_bench(const ClosedLoopScenario& s, CompensationMode mode, hil::Ben
   h.law.compensation.nominal = s.deadzone;
   h.law.compensation.estimator = s.estimator;
   h.law.compensation.adaptation = s.adaptation;
+  h.law.compensation.reguess = s.reguess;
+  if (mode == CompensationMode::oracle) {  // the rig's true edges, from the same schedule as the slave's
+    h.law.oracle.push_back({0, s.rig_config.pilot_valve.deadzone_right_mA, -s.rig_config.pilot_valve.deadzone_left_mA});
+    for (const auto& c : h.plant.drift)
+      h.law.oracle.push_back({static_cast<std::int64_t>(c.control_step), c.params.deadzone_right_mA, -c.params.deadzone_left_mA});
+  }
   h.reference = s.reference;
   h.duration_s = s.duration_s;
   h.score_t0_s = s.score_t0_s;
@@ -370,6 +445,11 @@ ClosedLoopScenarioResult run_closed_loop_scenario(const ClosedLoopScenario& s, C
     res.final_right = c.right;
     res.final_left = c.left;
     res.updates = c.updates;
+    res.reguesses_right = c.reguesses_right;
+    res.reguesses_left = c.reguesses_left;
+    res.guess_right = c.guess_right;
+    res.guess_left = c.guess_left;
+    res.events = c.events;
     res.reason = c.reason;
     res.estimator_identified = c.estimator_identified;
     res.estimator_reason = c.estimator_reason;
@@ -380,15 +460,30 @@ ClosedLoopScenarioResult run_closed_loop_scenario(const ClosedLoopScenario& s, C
   cc.nominal = s.backlash;
   cc.estimator = s.backlash_estimator;
   cc.adaptation = s.adaptation;
+  cc.reguess = s.reguess;
   BacklashCompensator comp(cc);
   rigs::CoupledCarts rig(s.rig_config.coupled_carts, dt, s.seed);
   TrackingAccumulator track{dt, s.score_t0_s, s.score_t1_s, 0.0, {}};
   double y = rig.free_position_m(), w = rig.motor_position_m();
   bool first = true;
   double wstar1 = 0.0;
+  double truth = s.rig_config.coupled_carts.half_clearance_m;
   for (std::size_t k = 0; k < n; ++k) {
     const double t = static_cast<double>(k) * dt;
-    while (drift_due(k)) rig.set_params(s.drift[next_drift++].after.coupled_carts);
+    // a step: the drift's rig at its sample; a ramp: the rig once per sample until it ends
+    while (drift_due(k)) {
+      const Drift& d = s.drift[next_drift];
+      if (static_cast<std::int64_t>(k) < step_of(d.at_s, dt) + ramp_n(d, dt)) {
+        const rigs::RigConfig now = rig_config_at(s, static_cast<std::int64_t>(k));
+        rig.set_params(now.coupled_carts);
+        truth = now.coupled_carts.half_clearance_m;
+        break;
+      }
+      rig.set_params(d.after.coupled_carts);
+      truth = d.after.coupled_carts.half_clearance_m;
+      ++next_drift;
+    }
+    comp.set_oracle(truth, truth);  // oracle only (false otherwise)
     const double r = ref.next();
     if (first) {
       comp.reset(r);

@@ -277,7 +277,8 @@ CalibrationPage initial_calibration(const MasterConfig& c) noexcept {
 namespace {
 // A page's compensation value as a mode (the XCP slave admits only the integers 0..2).
 CompensationMode mode_of(double v) noexcept {
-  return v <= 0.5 ? CompensationMode::none : (v <= 1.5 ? CompensationMode::fixed : CompensationMode::adaptive);
+  return v <= 0.5 ? CompensationMode::none
+                  : (v <= 1.5 ? CompensationMode::fixed : (v <= 2.5 ? CompensationMode::adaptive : CompensationMode::oracle));
 }
 }  // namespace
 
@@ -481,6 +482,10 @@ double MasterNode::law(double r, double y) noexcept {
   if (!comp_) return controller_.step(r, y);
   const CompensatedLaw& c = *cfg_.law;
   const double u = pid_->step(r - y) + c.feedforward * r;
+  while (next_oracle_ < c.oracle.size() && c.oracle[next_oracle_].control_step <= m_) {
+    comp_->set_oracle(c.oracle[next_oracle_].right_mA, c.oracle[next_oracle_].left_mA);
+    ++next_oracle_;
+  }
   double i = comp_->command(u);
   i = i < c.command_min ? c.command_min : (i > c.command_max ? c.command_max : i);
   comp_->observe(i, y, true);  // law() runs on a fresh sensor value only (control())
@@ -503,6 +508,11 @@ CompensationState MasterNode::compensation() const noexcept {
     c.left = -comp_->inverse().params().offset_left;
   }
   c.updates = comp_->updates();
+  c.reguesses_right = comp_->adapter().reguesses(Side::right);
+  c.reguesses_left = comp_->adapter().reguesses(Side::left);
+  c.guess_right = comp_->adapter().guess(Side::right);
+  c.guess_left = comp_->adapter().guess(Side::left);
+  c.events = comp_->events();
   c.reason = comp_->reason();
   c.estimator_identified = comp_->estimator().params(Side::right).identified &&
                            comp_->estimator().params(Side::left).identified;

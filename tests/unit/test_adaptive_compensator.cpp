@@ -254,7 +254,8 @@ TEST(CompensatorCalibration, ModeSwitchNominalEdgesAndDither) {
   // refused: nothing changes
   EXPECT_FALSE(c.set_nominal(-1.0, 310.0));
   EXPECT_FALSE(c.set_nominal(300.0, std::nan("")));
-  EXPECT_FALSE(c.set_mode(static_cast<CompensationMode>(3)));
+  EXPECT_FALSE(c.set_mode(static_cast<CompensationMode>(4)));  // 3 is oracle
+  EXPECT_FALSE(c.set_oracle(250.0, 260.0));  // only in oracle mode
   EXPECT_EQ(c.command(100.0), 400.0);
   EXPECT_EQ(c.config().mode, CompensationMode::fixed);
   // adaptive with a dither of 5 mA, period 4 samples: +5, +5, −5, −5, +5 on u before the inverse

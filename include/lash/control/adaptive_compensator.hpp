@@ -23,17 +23,22 @@
 ///   θ(k) = θ(k−1) + clamp(θ*(k) − θ(k−1), −ρT, ρT),   θ* = θ̂ if valid for settle_s,
 ///          θ* = θ(k−1) within hold_s of the last valid sample, θ* = θ_nominal after that.
 /// Real time: command() and observe() are noexcept, O(1) and allocation-free.
+#include <array>
 #include <cstdint>
 
 #include "lash/blocks/backlash_inverse.hpp"
 #include "lash/blocks/deadzone_inverse.hpp"
 #include "lash/identify/estimators.hpp"
+#include "lash/identify/reguess.hpp"
+#include "lash/metrics/page_hinkley.hpp"
 
 namespace lash {
 
-/// none: no inverse; fixed: the nominal inverse; adaptive: nominal, adapted online.
-enum class CompensationMode : std::uint8_t { none, fixed, adaptive };
-/// "none" | "fixed" | "adaptive"; throws std::invalid_argument otherwise.
+/// none: no inverse; fixed: the nominal inverse; adaptive: nominal, adapted online; oracle: the
+/// inverse fed the plant's true current parameters by the caller (set_oracle) at every sample —
+/// the best any adaptation can do with this controller, the reference adaptive is judged against.
+enum class CompensationMode : std::uint8_t { none, fixed, adaptive, oracle };
+/// "none" | "fixed" | "adaptive" | "oracle"; throws std::invalid_argument otherwise.
 CompensationMode parse_compensation_mode(const char* text);
 const char* to_string(CompensationMode m) noexcept;
 
@@ -58,6 +63,50 @@ struct AdaptationSettings {
   void validate() const;
   /// The same checks as validate(), without an exception (real time: calibration writes).
   bool valid() const noexcept;
+};
+
+/// Change detection on each adapted parameter (docs/compensation.md "Drift events"): a two-sided
+/// Page–Hinkley test (metrics/page_hinkley.hpp: Page 1954; Basseville & Nikiforov 1993 §2.2.3)
+/// on the parameter's estimate against its running mean since the last alarm, fed on the samples
+/// where the gate uses the estimate (reason `adapting`: identified, plausible, excited, settled),
+/// after the first warmup_s of such samples of that side (the start-up transient of the estimate).
+/// δ = allowance_ratio × nominal; h = δ × delay_s / T: a change of 2δ sustained for delay_s
+/// alarms. An alarm is a `drift` event (old = the mean before the estimated change time, new =
+/// the estimate now); the test then rests for rearm_s of adapting samples (the estimate's
+/// transient after a change) and starts again on the level it finds.
+struct DriftDetectSettings {
+  bool enabled = true;
+  double allowance_ratio = 0.1;   ///< δ / nominal [-], > 0
+  double delay_s = 0.25;          ///< a change of 2δ alarms after this long [s], > 0
+  double warmup_s = 5.0;          ///< adapting time of a side before its test starts [s], >= 0
+  double rearm_s = 2.0;           ///< adapting time after an alarm before the test restarts [s], >= 0
+  /// Throws std::invalid_argument naming the field.
+  void validate() const;
+};
+
+/// What the adaptive compensator reports besides its parameters: a re-guess of a side's
+/// switching guess (identify/reguess.hpp) or a detected drift of a side's parameter.
+struct AdaptationEvent {
+  enum class Kind : std::uint8_t { reguess, drift };
+  Kind kind = Kind::drift;
+  Side side = Side::right;
+  ReguessRule rule = ReguessRule::none;  ///< reguess: out or in
+  std::uint64_t sample = 0;              ///< observe() call (0-based; t = sample·T) [-]
+  double old_value = 0.0;                ///< reguess: the guess before [v unit]; drift: the level before [parameter unit]
+  double new_value = 0.0;                ///< reguess: the new guess; drift: the estimate at the alarm
+};
+const char* to_string(AdaptationEvent::Kind k) noexcept;
+
+/// The first kCapacity events of a run (no allocation; later ones are counted as dropped).
+struct AdaptationEvents {
+  static constexpr std::size_t kCapacity = 32;
+  std::array<AdaptationEvent, kCapacity> events{};
+  std::uint32_t n = 0;
+  std::uint64_t dropped = 0;
+  void add(const AdaptationEvent& e) noexcept {
+    if (n < kCapacity) events[n++] = e;
+    else ++dropped;
+  }
 };
 
 /// Why the inverse holds the values it holds (the compensator's own verdict).
@@ -152,10 +201,16 @@ struct CompensationConfig {
   typename Adapter::Params nominal;              ///< the fixed inverse; the start of the adaptive one
   typename Adapter::EstimatorSettings estimator;  ///< dt_s is the loop's
   AdaptationSettings adaptation;
+  /// Online re-guessing of the estimator's switching guesses (identify/reguess.hpp).
+  ReguessSettings reguess;
+  /// Drift events on the adapted parameters (Page–Hinkley).
+  DriftDetectSettings detect;
   /// Throws std::invalid_argument naming the field.
   void validate() const {
     nominal.validate();
     adaptation.validate();
+    reguess.validate();
+    detect.validate();
     Adapter::validate(estimator);
   }
 };
@@ -170,7 +225,9 @@ struct CompensationConfig {
 ///   - static apply(Inverse&, double right, double left, const Params& nominal) noexcept;
 ///   - static in_use(const Inverse&) -> PerSide<double>, the parameters as reported;
 ///   - Adapter(const CompensationConfig<Adapter>&);
-///   - step(double a, double b) noexcept -> PerSide<GateInput>, one sample of the estimator;
+///   - step(double a, double b, PerSide<double> in_use) noexcept -> PerSide<GateInput>, one sample
+///     of the estimator (in_use: the gates' values before it, for the re-guessing's edge);
+///   - reguesses(Side), guess(Side): the re-guessing's moves and the side's guess now;
 ///   - restart() noexcept, a gap in the samples (observe(…, fresh = false)): the estimator's
 ///     restart() and the adapter's own sample history, estimates kept;
 ///   - refine(Side, AdaptationReason) noexcept, the adapter's own refusal (e.g. not_excited);
@@ -196,14 +253,17 @@ class Compensator {
         adapter_(c),
         gate_r_(Adapter::nominal(c.nominal).right, c.estimator.dt_s, c.adaptation),
         gate_l_(Adapter::nominal(c.nominal).left, c.estimator.dt_s, c.adaptation),
-        dither_(c.adaptation.dither_amplitude, c.adaptation.dither_period_s, c.estimator.dt_s) {}
+        dither_(c.adaptation.dither_amplitude, c.adaptation.dither_period_s, c.estimator.dt_s),
+        ph_{PageHinkley(detector(Adapter::nominal(c.nominal).right, c)),
+            PageHinkley(detector(Adapter::nominal(c.nominal).left, c))} {}
 
   /// Desired output u(k) of the nonlinearity → its input (the command; dither added to u first,
   /// adaptive only).
   double command(double u) noexcept {
     switch (cfg_.mode) {
       case CompensationMode::none: return u;
-      case CompensationMode::fixed: return inv_.step(u);
+      case CompensationMode::fixed:
+      case CompensationMode::oracle: return inv_.step(u);
       case CompensationMode::adaptive: break;
     }
     return inv_.step(u + dither_.step());
@@ -228,6 +288,7 @@ class Compensator {
   /// only). Every step fresh = exactly the sequence without this argument.
   void observe(double a, double b, bool fresh) noexcept {
     if (cfg_.mode != CompensationMode::adaptive) return;
+    const std::uint64_t k = k_++;
     if (!fresh) {
       adapter_.restart();
       stepped_ = false;
@@ -235,7 +296,10 @@ class Compensator {
       return;
     }
     stepped_ = true;
-    const PerSide<GateInput> e = adapter_.step(a, b);
+    const std::uint64_t n_r = adapter_.reguesses(Side::right), n_l = adapter_.reguesses(Side::left);
+    const PerSide<GateInput> e = adapter_.step(a, b, {gate_r_.value(), gate_l_.value()});
+    if (adapter_.reguesses(Side::right) != n_r) [[unlikely]] reguessed(Side::right, k);
+    if (adapter_.reguesses(Side::left) != n_l) [[unlikely]] reguessed(Side::left, k);
     const double old_r = gate_r_.value(), old_l = gate_l_.value();
     const double r = gate_r_.step(e.right.ok, e.right.value);
     const double l = gate_l_.step(e.left.ok, e.left.value);
@@ -243,8 +307,29 @@ class Compensator {
       Adapter::apply(inv_, r, l, cfg_.nominal);
       ++updates_;
     }
+    if (cfg_.detect.enabled) {
+      if (gate_r_.reason() == AdaptationReason::adapting && ++adapting_.right > armed_at_.right)
+        detect(Side::right, e.right.value, k);
+      if (gate_l_.reason() == AdaptationReason::adapting && ++adapting_.left > armed_at_.left)
+        detect(Side::left, e.left.value, k);
+    }
   }
+  /// Re-guesses and drift events so far (the first AdaptationEvents::kCapacity).
+  const AdaptationEvents& events() const noexcept { return events_; }
+  /// Drift events per side so far (all, including those past the event record's capacity).
+  std::uint64_t drifts(Side s) const noexcept { return drifts_[s]; }
 
+  /// Oracle mode: the inverse's two parameters (Adapter::nominal's meaning) are the plant's true
+  /// ones now; call before command(). false (nothing changes) in another mode or for a value
+  /// that is not finite and >= 0.
+  bool set_oracle(double right, double left) noexcept {
+    if (cfg_.mode != CompensationMode::oracle || !(right >= 0.0 && right < 1e300 && left >= 0.0 && left < 1e300))
+      return false;
+    const PerSide<double> now = Adapter::in_use(inv_);
+    Adapter::apply(inv_, right, left, cfg_.nominal);
+    if (Adapter::in_use(inv_).right != now.right || Adapter::in_use(inv_).left != now.left) ++updates_;
+    return true;
+  }
   const Inverse& inverse() const noexcept { return inv_; }
   const Estimator& estimator() const noexcept { return adapter_.estimator(); }
   const Adapter& adapter() const noexcept { return adapter_; }
@@ -285,7 +370,9 @@ class Compensator {
   /// its first sample equals one built adaptive, and switches with no sample between them act
   /// as the last one alone). The same mode: nothing changes.
   bool set_mode(CompensationMode m) noexcept {
-    if (m != CompensationMode::none && m != CompensationMode::fixed && m != CompensationMode::adaptive) return false;
+    if (m != CompensationMode::none && m != CompensationMode::fixed && m != CompensationMode::adaptive &&
+        m != CompensationMode::oracle)
+      return false;
     if (m == cfg_.mode) return true;
     cfg_.mode = m;
     restart_from_nominal();
@@ -320,6 +407,22 @@ class Compensator {
   }
 
  private:
+  static PageHinkleySettings detector(double nominal, const Config& c) {
+    const double delta = c.detect.allowance_ratio * (nominal > 0.0 ? nominal : 1.0);
+    return {delta, delta * c.detect.delay_s / c.estimator.dt_s};
+  }
+  void reguessed(Side s, std::uint64_t k) noexcept {
+    const SideReguess& g = adapter_.reguess(s);
+    events_.add({AdaptationEvent::Kind::reguess, s, g.last_rule(), k, g.last_old_guess(), g.guess()});
+  }
+  void detect(Side s, double x, std::uint64_t k) noexcept {
+    const PageHinkley::Change c = ph_[s].update(x);
+    if (c == PageHinkley::Change::none) return;
+    events_.add({AdaptationEvent::Kind::drift, s, ReguessRule::none, k, ph_[s].mean_before(c), x});
+    ++drifts_[s];
+    ph_[s].reset();
+    armed_at_[s] = adapting_[s] + rearm_n_;
+  }
   void restart_from_nominal() noexcept {
     const PerSide<double> n = Adapter::nominal(cfg_.nominal);
     const double dt = cfg_.estimator.dt_s;
@@ -327,6 +430,8 @@ class Compensator {
     gate_l_.restart(n.left, cfg_.adaptation, dt);
     inv_.set_params(cfg_.nominal);
     dither_.restart();
+    ph_.right.reset();
+    ph_.left.reset();
   }
 
   Config cfg_;
@@ -334,6 +439,14 @@ class Compensator {
   Adapter adapter_;
   ParameterGate gate_r_, gate_l_;
   Dither dither_;
+  PerSide<PageHinkley> ph_;
+  AdaptationEvents events_;
+  PerSide<std::uint64_t> drifts_{};
+  PerSide<std::uint64_t> adapting_{};  ///< samples each side's gate adapted (the detector's warm-up)
+  std::uint64_t rearm_n_ = static_cast<std::uint64_t>(cfg_.detect.rearm_s / cfg_.estimator.dt_s);
+  PerSide<std::uint64_t> armed_at_ = PerSide<std::uint64_t>::both(
+      static_cast<std::uint64_t>(cfg_.detect.warmup_s / cfg_.estimator.dt_s));  ///< the test runs past this count
+  std::uint64_t k_ = 0;  ///< observe() calls in adaptive mode
   std::uint64_t updates_ = 0, stale_ = 0;
   bool stepped_ = false;  ///< the adapter was stepped since it was built or last restarted
 };
@@ -367,7 +480,12 @@ class DeadzoneAdapter {
     need_ = {c.adaptation.min_excitation_ratio * c.nominal.offset_right,
              c.adaptation.min_excitation_ratio * c.nominal.offset_left};
   }
-  PerSide<GateInput> step(double v_applied, double y) noexcept;
+  /// in_use: the inverse's edges as magnitudes (the gates' values), the re-guessing's ĉ.
+  PerSide<GateInput> step(double v_applied, double y, const PerSide<double>& in_use) noexcept;
+  /// Re-guesses of side s so far (identify/reguess.hpp), and the side's guess now [mA].
+  std::uint64_t reguesses(Side s) const noexcept { return rg_.count(s); }
+  const SideReguess& reguess(Side s) const noexcept { return rg_.side(s); }
+  double guess(Side s) const noexcept { return s == Side::right ? ecfg_.guess_right : ecfg_.guess_left; }
   /// A gap: the estimator's restart(); the excitation record skips the samples the estimator
   /// does not update on (its warm-up), as it skips those inside the guesses.
   void restart() noexcept {
@@ -386,7 +504,8 @@ class DeadzoneAdapter {
   InputDeadzoneEstimator est_;
   EstimatorConfig ecfg_;
   PerSide<double> need_;  // min_excitation_ratio × nominal per side
-  detail::Excitation exc_r_, exc_l_;
+  PerSide<detail::Excitation> exc_;
+  Reguesser rg_;
   double v1_ = 0.0;
   PerSide<bool> not_excited_{};
 };
@@ -433,18 +552,29 @@ class BacklashAdapter {
     inv.set_params({right, left, nominal.smoothing});
   }
   static PerSide<double> in_use(const BacklashInverse& inv) noexcept { return {inv.params().right, inv.params().left}; }
-  explicit BacklashAdapter(const CompensationConfig<BacklashAdapter>& c) : est_(c.estimator), s_(c.estimator.input_shift) {}
-  /// w: driving position, y: driven position, both measured at k.
-  PerSide<GateInput> step(double w, double y) noexcept {
+  explicit BacklashAdapter(const CompensationConfig<BacklashAdapter>& c)
+      : est_(c.estimator),
+        s_(c.estimator.input_shift),
+        rg_(c.estimator.guess_right, c.estimator.guess_left, c.reguess, c.estimator.dt_s) {}
+  /// w: driving position, y: driven position, both measured at k; in_use: the inverse's gaps
+  /// (the re-guessing's edges c_R = s + (c_r − c_l')/2, c_L = −s + (c_r − c_l')/2).
+  PerSide<GateInput> step(double w, double y, const PerSide<double>& in_use) noexcept {
     if (gap_) {  // after restart(): y1_ is from before the gap; this sample only refills it
       gap_ = false;
       y1_ = y;
       return gates();
     }
-    est_.step(w >= 0.0 ? w + s_ : w - s_, y1_);
+    const double v = w >= 0.0 ? w + s_ : w - s_;
+    est_.step(v, y1_);
     y1_ = y;
+    const double mid = 0.5 * (in_use.right - in_use.left);
+    rg_.follow(est_, v1_, {s_ + mid, -s_ + mid});
+    v1_ = v;
     return gates();
   }
+  std::uint64_t reguesses(Side s) const noexcept { return rg_.count(s); }
+  const SideReguess& reguess(Side s) const noexcept { return rg_.side(s); }
+  double guess(Side s) const noexcept { return rg_.guess(s); }
   /// A gap: the estimator's restart(), and the driven position one sample late is dropped.
   void restart() noexcept {
     est_.restart();
@@ -462,7 +592,8 @@ class BacklashAdapter {
   }
   DeadzoneDeadbandEstimator est_;
   double s_;
-  double y1_ = 0.0;
+  Reguesser rg_;
+  double y1_ = 0.0, v1_ = 0.0;
   bool gap_ = false;
 };
 

@@ -30,13 +30,17 @@
 
 namespace lash::experiments {
 
-/// One parameter change of the rig at `at_s` (the full rig configuration after it).
+/// One parameter change of the rig: a step at `at_s` (ramp_s = 0) or a linear ramp from the value
+/// before to `value` over [at_s, at_s + ramp_s] (wear), moving once per sample.
 struct Drift {
   double at_s = 0.0;         ///< [s]
+  double ramp_s = 0.0;       ///< [s]; 0 = a step
   std::string param;         ///< a `[rig_params]` key
   double value = 0.0;        ///< its new value [the key's unit]
-  rigs::RigConfig after;     ///< the rig's parameters from at_s on (earlier drifts included)
+  rigs::RigConfig before;    ///< the rig's parameters before at_s (earlier drifts included)
+  rigs::RigConfig after;     ///< the rig's parameters from at_s + ramp_s on (earlier drifts included)
 };
+
 
 struct ClosedLoopScenario {
   std::string file;                  ///< where it was read from ("" = built in code)
@@ -45,7 +49,7 @@ struct ClosedLoopScenario {
   double duration_s = 40.0;          ///< [s]
   std::uint64_t seed = 1;            ///< rig noise seed
   rigs::RigConfig rig_config;        ///< the rig at t = 0
-  std::vector<Drift> drift;          ///< in time order
+  std::vector<Drift> drift;          ///< in time order (a drift starts after the previous one ended)
   SignalSpec reference;              ///< r [kPa or m]
   PidConfig pid;                     ///< the controller (dt = dt_s)
   /// Reference feedforward u_ff = feedforward·r added to the PID output (a 2-DOF loop: the
@@ -60,8 +64,14 @@ struct ClosedLoopScenario {
   EstimatorConfig estimator;         ///< valve: the adaptive compensator's input-deadzone estimator
   BacklashEstimatorConfig backlash_estimator;  ///< carts: the adaptive compensator's deadzone-deadband estimator
   AdaptationSettings adaptation;
+  ReguessSettings reguess;           ///< [compensation] reguess = true|false (identify/reguess.hpp)
   double score_t0_s = 0.0, score_t1_s = 0.0;  ///< score window [s]
 };
+
+/// The rig's parameters at sample k of a run: the drifts applied, a ramp interpolated linearly
+/// per sample (f = (k − k0)/n, k0 = round(at_s/dt_s), n = round(ramp_s/dt_s); f = 1 gives the
+/// drift's value exactly). O(number of drifts).
+rigs::RigConfig rig_config_at(const ClosedLoopScenario& s, std::int64_t k);
 
 /// Reads a scenario TOML (keys in docs/compensation.md). Throws InputError (file:line:key).
 ClosedLoopScenario load_closed_loop_scenario(const std::filesystem::path& path);
@@ -81,6 +91,12 @@ struct ClosedLoopScenarioResult {
   double max_abs_error = 0.0;  ///< max |r − y| over the score window [rig output unit]
   double final_right = 0.0, final_left = 0.0;  ///< inverse parameters in use at the end (0 for none)
   std::uint64_t updates = 0;   ///< samples on which the inverse's parameters changed
+  /// Re-guesses of the estimator's switching guesses (identify/reguess.hpp) per side, and the
+  /// guesses at the end [v unit of the estimator: valve mA, carts m (shifted input)].
+  std::uint64_t reguesses_right = 0, reguesses_left = 0;
+  double guess_right = 0.0, guess_left = 0.0;
+  /// Re-guesses and drift events of the adaptive compensator (t = sample × dt_s).
+  AdaptationEvents events;
   AdaptationReason reason = AdaptationReason::nominal;
   std::string estimator_reason;  ///< the estimator's side of the verdict
   bool estimator_identified = false;

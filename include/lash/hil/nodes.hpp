@@ -165,6 +165,14 @@ struct CompensatedLaw {
   double feedforward = 0.0;           ///< [mA/kPa]
   double command_min = -2000.0, command_max = 2000.0;  ///< [mA], inside ±the bench's current range
   DeadzoneCompensationConfig compensation;
+  /// compensation.mode = oracle: the plant's true edges as magnitudes [mA] from control step m on
+  /// (in time order; the first at m = 0); the master sets them on the inverse before its step's
+  /// command (Compensator::set_oracle). Empty in the other modes.
+  struct TrueEdges {
+    std::int64_t control_step = 0;
+    double right_mA = 0.0, left_mA = 0.0;
+  };
+  std::vector<TrueEdges> oracle;
 };
 
 /// The compensator's state at the end of a run (trivially copyable: it crosses the hand-over).
@@ -173,6 +181,9 @@ struct CompensationState {
   CompensationMode mode = CompensationMode::none;
   double right = 0.0, left = 0.0;     ///< the inverse's edges in use (left as a negative current; 0 for none) [mA]
   std::uint64_t updates = 0;          ///< samples on which the inverse's parameters changed
+  std::uint64_t reguesses_right = 0, reguesses_left = 0;  ///< the estimator's guesses moved (identify/reguess.hpp)
+  double guess_right = 0.0, guess_left = 0.0;  ///< the estimator's switching guesses at the end [mA]
+  AdaptationEvents events;            ///< re-guesses and drift events (sample = the law's control step)
   AdaptationReason reason = AdaptationReason::nominal;
   bool estimator_identified = false;  ///< both sides identified by the estimator's verdict
   char estimator_reason[320] = {};    ///< "right: …; left: …" (truncated to fit)
@@ -379,6 +390,7 @@ class MasterNode {
   XcpLink* link_ = nullptr;
   double loop_tet_us_ = 0.0, loop_wake_us_ = 0.0, loop_overruns_ = 0.0;  ///< set_loop_figures (console)
   std::size_t next_change_ = 0;
+  std::size_t next_oracle_ = 0;  ///< scenario law, oracle: the next TrueEdges
   std::vector<CalibrationEvent> cal_events_;
   std::size_t n_cal_events_ = 0;
 };
