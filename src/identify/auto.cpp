@@ -85,7 +85,7 @@ struct Selection {
         double* out = inside.data();
         for (std::size_t j = i; j < i + 16; ++j) {
           out[kept] = x[j];
-          kept += (x[j] > l) & (x[j] < h) ? 1 : 0;
+          kept += ((x[j] > l) & (x[j] < h)) ? 1 : 0;
         }
       }
     }
