@@ -103,7 +103,7 @@ std::uint64_t ReportingReader::finish() {
   const auto& report = report_;
   for (std::size_t i = 0; i < report.problems.size() && i < kShown; ++i) {
     const std::string& p = report.problems[i];
-    fmt::print(stderr, "lash can {}: dropped: {}\n", who_, p.size() <= 200 ? p : p.substr(0, 200) + "\u2026");
+    fmt::print(stderr, "lash can {}: dropped: {}\n", who_, bounded(p));
   }
   if (report.dropped > kShown)
     fmt::print(stderr, "lash can {}: ... and {} more dropped records\n", who_, report.dropped - kShown);

@@ -14,6 +14,7 @@
 #include "lash/identify/estimate_report.hpp"
 #include "lash/identify/reguess.hpp"
 #include "lash/io/error.hpp"
+#include "lash/io/table.hpp"
 
 namespace lash::py {
 
@@ -60,6 +61,7 @@ class Estimator {
     cfg_ = set.cfg;
     job_ = set.job;
     est_ = std::make_unique<AnyEstimator>(cfg_);
+    gaps_.emplace(cfg_.dt_s);
     make_reguesser();
   }
 
@@ -101,6 +103,7 @@ class Estimator {
   void reset() {
     est_ = std::make_unique<AnyEstimator>(cfg_);
     make_reguesser();
+    gaps_->reset();
     t_.clear();
     v_.clear();
     y_.clear();
@@ -145,8 +148,8 @@ class Estimator {
   }
   double next_t() const noexcept { return static_cast<double>(t_.size()) * cfg_.dt_s; }
   void step(double v, double y, double t) {
-    // a step of t longer than kGapFactor sample periods is a gap (io/table.hpp): restart there
-    if (!t_.empty() && t - t_.back() > kGapFactor * cfg_.dt_s) est_->restart();
+    // the library's gap rule for streams (io/table.hpp StreamGaps): restart the regressors there
+    if (gaps_->gap_before(t)) est_->restart();
     t_.push_back(t);
     v_.push_back(v);
     y_.push_back(y);
@@ -166,6 +169,7 @@ class Estimator {
   bool reguess_ = false;
   std::optional<Reguesser> rg_;
   double vprev_ = 0.0;
+  std::optional<StreamGaps> gaps_;  // set with cfg_ (its nominal period)
   std::vector<double> t_, v_, y_, ysim_;
   double yhat_ = 0.0;
 };

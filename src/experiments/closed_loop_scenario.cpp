@@ -8,6 +8,7 @@
 #include "lash/hil/node_run.hpp"
 #include "lash/hil/schedule.hpp"
 #include "lash/identify/config_file.hpp"
+#include "lash/identify/verdict.hpp"
 #include "lash/io/error.hpp"
 #include "lash/io/memory.hpp"
 #include "lash/io/toml_util.hpp"
@@ -338,8 +339,9 @@ void finish(ClosedLoopScenarioResult& res, const Comp& comp) {
   res.events = comp.events();
   res.reason = comp.reason();
   res.estimator_identified = comp.adapter().identified(Side::right) && comp.adapter().identified(Side::left);
-  res.estimator_reason = std::string("right: ") + comp.estimator_reason(Side::right) +
-                         "; left: " + comp.estimator_reason(Side::left);
+  char reason[sizeof(hil::CompensationState::estimator_reason)];  // the master's (the same text)
+  both_sides_reason(reason, comp.estimator_reason(Side::right), comp.estimator_reason(Side::left));
+  res.estimator_reason = reason;
 }
 
 }  // namespace

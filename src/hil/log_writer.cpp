@@ -138,6 +138,15 @@ void NodeLogWriter::flush_events(std::uint32_t) {
   pending_calibration_.clear();
 }
 
+void NodeLogWriter::count_step(const rt::StepRecord& r) noexcept {
+  ++stats_.rows;
+  stats_.last_t_s = static_cast<double>(r.release_ns) * 1e-9;
+  tet_.add(us(r.tet_ns));
+  io_.add(us(r.io_ns));
+  cycle_.add(us(r.io_ns + r.tet_ns));
+  wake_.add(us(r.wake_latency_ns));
+}
+
 void NodeLogWriter::take(const LogItem& item) {
   if (const auto* m = std::get_if<MasterRow>(&item)) {
     flush_events(m->log.step);
@@ -154,12 +163,7 @@ void NodeLogWriter::take(const LogItem& item) {
       append_double(o, l.calibration.*f.member);
     }
     o += '\n';
-    ++stats_.rows;
-    stats_.last_t_s = static_cast<double>(r.release_ns) * 1e-9;
-    tet_.add(us(r.tet_ns));
-    io_.add(us(r.io_ns));
-    cycle_.add(us(r.io_ns + r.tet_ns));
-    wake_.add(us(r.wake_latency_ns));
+    count_step(r);
   } else if (const auto* s = std::get_if<SlaveRow>(&item)) {
     flush_events(s->log.step);
     const auto& l = s->log;
@@ -170,12 +174,7 @@ void NodeLogWriter::take(const LogItem& item) {
                        l.measured_kPa, static_cast<double>(l.pilot_raw), us(r.tet_ns), us(r.io_ns),
                        us(r.wake_latency_ns)});
     csv_.pending += '\n';
-    ++stats_.rows;
-    stats_.last_t_s = static_cast<double>(r.release_ns) * 1e-9;
-    tet_.add(us(r.tet_ns));
-    io_.add(us(r.io_ns));
-    cycle_.add(us(r.io_ns + r.tet_ns));
-    wake_.add(us(r.wake_latency_ns));
+    count_step(r);
   } else if (const auto* f = std::get_if<LoggedFrame>(&item)) {
     if (bus_.fd < 0) return;
     can::Frame g = f->frame;

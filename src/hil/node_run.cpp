@@ -139,6 +139,22 @@ void take_loop(const rt::PeriodicLoop& loop, LoopTrace& t) {
   t.overruns.assign(loop.overruns().begin(), loop.overruns().end());
 }
 
+// Stops a node's log writer (its last rows reach the disk; a write error becomes a warning) and
+// takes its counts and the loop's summaries into the node's statistics.
+void finish_writer(NodeLogWriter& writer, NodeStats& stats, LoopTrace& loop) {
+  try {
+    writer.stop();
+  } catch (const std::exception& e) {
+    loop.warnings.push_back(e.what());
+  }
+  stats.logs = writer.stats();
+  const LoopSummaries sum = writer.loop();
+  stats.tet_us = sum.tet_us;
+  stats.io_us = sum.io_us;
+  stats.cycle_us = sum.cycle_us;
+  stats.wake_latency_us = sum.wake_latency_us;
+}
+
 FrameStats frame_stats(const SeqTracker& seq, std::uint64_t sent, std::uint64_t ignored, std::uint64_t send_failures,
                        const can::BusStats& bs) {
   FrameStats f;
@@ -216,17 +232,7 @@ SlaveRun run_slave_node(const BenchSettings& s, const SlaveRunOptions& o, const 
         stop);
   }
   for (const auto ev = slave.events(); events_seen < ev.size(); ++events_seen) writer.push(ev[events_seen]);
-  try {
-    writer.stop();
-  } catch (const std::exception& e) {
-    out.loop.warnings.push_back(e.what());
-  }
-  out.stats.logs = writer.stats();
-  const LoopSummaries sum = writer.loop();
-  out.stats.tet_us = sum.tet_us;
-  out.stats.io_us = sum.io_us;
-  out.stats.cycle_us = sum.cycle_us;
-  out.stats.wake_latency_us = sum.wake_latency_us;
+  finish_writer(writer, out.stats, out.loop);
   take_loop(loop, out.loop);
   out.events.assign(slave.events().begin(), slave.events().end());
   out.stats.state = slave.state();
@@ -316,17 +322,7 @@ MasterRun run_master_node(const BenchSettings& s, const MasterRunOptions& o, con
     out.stats.xcp_samples_lost = xs.samples_lost;
     out.stats.xcp_pages = xs.pages;
   }
-  try {
-    writer.stop();
-  } catch (const std::exception& e) {
-    out.loop.warnings.push_back(e.what());
-  }
-  out.stats.logs = writer.stats();
-  const LoopSummaries sum = writer.loop();
-  out.stats.tet_us = sum.tet_us;
-  out.stats.io_us = sum.io_us;
-  out.stats.cycle_us = sum.cycle_us;
-  out.stats.wake_latency_us = sum.wake_latency_us;
+  finish_writer(writer, out.stats, out.loop);
   out.calibration.assign(master.calibration_events().begin(), master.calibration_events().end());
   take_loop(loop, out.loop);
   out.events.assign(master.events().begin(), master.events().end());

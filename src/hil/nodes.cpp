@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "lash/identify/verdict.hpp"
 #include "lash/rt/periodic.hpp"
 
 namespace lash::hil {
@@ -516,8 +517,7 @@ CompensationState MasterNode::compensation() const noexcept {
   c.reason = comp_->reason();
   c.estimator_identified = comp_->estimator().params(Side::right).identified &&
                            comp_->estimator().params(Side::left).identified;
-  std::snprintf(c.estimator_reason, sizeof c.estimator_reason, "right: %s; left: %s",
-                comp_->estimator_reason(Side::right), comp_->estimator_reason(Side::left));
+  both_sides_reason(c.estimator_reason, comp_->estimator_reason(Side::right), comp_->estimator_reason(Side::left));
   return c;
 }
 

@@ -1,6 +1,7 @@
 #include "lash/identify/verdict.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <utility>
 
 namespace lash {
@@ -16,6 +17,10 @@ const char* to_string(Reason r) noexcept {
     case Reason::wrong_guess: return "wrong_guess";
   }
   return "?";
+}
+
+void both_sides_reason(std::span<char> out, const char* right, const char* left) noexcept {
+  if (!out.empty()) std::snprintf(out.data(), out.size(), "right: %s; left: %s", right, left);
 }
 
 namespace verdict_rules {

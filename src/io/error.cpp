@@ -3,9 +3,7 @@
 #include <fmt/core.h>
 
 namespace lash {
-namespace {
-/// At most `max` bytes of `s` (cut before a UTF-8 continuation byte), then "… (N bytes)": an
-/// error never echoes a whole 300 MB header line or a million column names.
+
 std::string bounded(std::string s, std::size_t max) {
   if (s.size() <= max) return s;
   const std::size_t n = s.size();
@@ -14,6 +12,8 @@ std::string bounded(std::string s, std::size_t max) {
   s.resize(cut);
   return s + fmt::format("\u2026 ({} bytes)", n);
 }
+
+namespace {
 constexpr std::size_t kMaxField = 200;     // a name or a value quoted from the input
 constexpr std::size_t kMaxMessage = 1000;  // what was wrong (it may quote the input too)
 

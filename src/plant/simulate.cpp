@@ -31,15 +31,17 @@ std::size_t sample_count(double duration_s, double dt_s) {
 std::uint64_t noise_seed(std::uint64_t seed) noexcept { return seed ^ 0x6c617368'6e6f6973ULL; }
 
 SimulationTrace simulate(Plant& plant, const SimulationSpec& spec) {
-  if (!(std::isfinite(spec.noise_variance) && spec.noise_variance >= 0))
-    throw std::invalid_argument("noise variance must be >= 0");
-  const std::size_t n = sample_count(spec.duration_s, plant.dt_s());
-  SignalSpec in = spec.input;
-  in.seed = spec.seed;
-  Signal sig(in, plant.dt_s());
-  std::vector<double> v(n);
-  for (auto& x : v) x = sig.next();
-  return simulate(plant, v, spec.noise_variance, spec.seed);
+  SimulationTrace tr;
+  tr.names = simulation_columns(plant);
+  tr.cols.resize(tr.names.size());
+  if (std::isfinite(spec.noise_variance) && spec.noise_variance >= 0) {  // else simulate_rows says why
+    const std::size_t n = sample_count(spec.duration_s, plant.dt_s());
+    for (auto& c : tr.cols) c.reserve(n);
+  }
+  simulate_rows(plant, spec, [&](std::span<const double> r) {
+    for (std::size_t c = 0; c < r.size(); ++c) tr.cols[c].push_back(r[c]);
+  });
+  return tr;
 }
 
 std::vector<std::string> simulation_columns(const Plant& plant) {

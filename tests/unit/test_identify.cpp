@@ -802,3 +802,13 @@ TEST(AnalyseRecord, QuantilesEqualFullCopiesToTheBit) {
 
 }  // namespace
 }  // namespace lash
+
+TEST(Verdict, BothSidesReasonIsOneTextTruncatedToFit) {
+  char buf[64];
+  lash::both_sides_reason(buf, "wrong_guess", "none");
+  EXPECT_STREQ(buf, "right: wrong_guess; left: none");
+  char small[10];  // 9 characters and the terminator: "right: wr"
+  lash::both_sides_reason(small, "wrong_guess", "none");
+  EXPECT_STREQ(small, "right: wr");
+}
+

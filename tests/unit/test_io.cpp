@@ -85,6 +85,31 @@ TEST(Error, OneBaseForEveryErrorAPersonSees) {
   }
 }
 
+TEST(Error, BoundedQuotesAtMost200BytesAndCountsTheRest) {
+  EXPECT_EQ(lash::bounded("short"), "short");
+  EXPECT_EQ(lash::bounded(std::string(200, 'x')), std::string(200, 'x'));  // exactly the bound: unchanged
+  // 300 bytes: the first 200, an ellipsis (U+2026, 3 bytes in UTF-8) and the whole count
+  EXPECT_EQ(lash::bounded(std::string(300, 'x')), std::string(200, 'x') + "\xE2\x80\xA6 (300 bytes)");
+  // never cut inside a character: 199 ASCII bytes then "é" (2 bytes) straddling the bound
+  const std::string s = std::string(199, 'a') + "\xC3\xA9" + std::string(50, 'b');
+  EXPECT_EQ(lash::bounded(s), std::string(199, 'a') + "\xE2\x80\xA6 (251 bytes)");
+}
+
+TEST(Table, StreamGapsIsTheRecordRuleWithTheNominalPeriod) {
+  // period 0.25 s (exact in binary): a step of exactly 5 periods (1.25 s) is not a gap, 1.5 s is;
+  // the same steps in a record whose median step is 0.25 s give the same gap rows
+  const std::vector<double> t{0.0, 0.25, 0.5, 1.75, 2.0, 3.5, 3.75};
+  lash::StreamGaps g(0.25);
+  std::vector<std::size_t> rows;
+  for (std::size_t i = 0; i < t.size(); ++i)
+    if (g.gap_before(t[i])) rows.push_back(i);
+  EXPECT_EQ(rows, (std::vector<std::size_t>{5}));
+  EXPECT_EQ(lash::analyse_sampling(t).gap_rows, rows);
+  g.reset();  // a new stream: its first sample is never a gap
+  EXPECT_FALSE(g.gap_before(100.0));
+  EXPECT_TRUE(g.gap_before(101.5));
+}
+
 TEST(AtomicFile, NothingLeftWithoutCommit) {
   const fs::path target = fs::temp_directory_path() / ("lash_atomic_" + std::to_string(::getpid()) + ".csv");
   {

@@ -111,6 +111,7 @@ class NodeLogWriter {
   void run() noexcept;
   void drain();
   void take(const LogItem& item);
+  void count_step(const rt::StepRecord& r) noexcept;  ///< a row written: counts and loop statistics
   void flush_events(std::uint32_t through_step);
   void write_out(File& f);
   void write_all();

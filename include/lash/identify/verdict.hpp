@@ -25,6 +25,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <span>
 
 #include "lash/blocks/side.hpp"
 
@@ -34,6 +35,11 @@ enum class Reason : std::uint8_t { none, not_updated, not_excited, unstable, unp
 
 /// "none", "not_updated", "not_excited", "unstable", "unphysical", "poor_fit", "wrong_guess".
 const char* to_string(Reason r) noexcept;
+
+/// The one text of both sides' verdicts, "right: <right>; left: <left>", written into `out`
+/// (truncated to fit, always NUL-terminated; nothing written if out is empty). noexcept and
+/// allocation-free: the master's real-time step reports it this way.
+void both_sides_reason(std::span<char> out, const char* right, const char* left) noexcept;
 
 /// Identified parameters of one side; NaN = not identified / not part of the model.
 struct SideParams {

@@ -10,9 +10,15 @@
 /// Configuration structs validated by the library throw std::invalid_argument (also exit 2:
 /// the values came from a person); anything else reaching `main` is a bug: exit 1, never abort.
 #include <stdexcept>
+#include <cstddef>
 #include <string>
 
 namespace lash {
+
+/// At most `max` bytes of `s` (cut before a UTF-8 continuation byte), then "… (N bytes)": an
+/// error never echoes a whole 300 MB header line or a million column names. InputError bounds
+/// its field to 200 bytes and its message to 1000 this way.
+std::string bounded(std::string s, std::size_t max = 200);
 
 /// Base of every error lash throws to a person; what() is the whole message.
 class Error : public std::runtime_error {

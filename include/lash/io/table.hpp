@@ -60,6 +60,28 @@ Table read_table(const std::filesystem::path& path, const TableOptions& options 
 /// period is the median step, so a gap is never averaged into dt.
 inline constexpr double kGapFactor = 5.0;
 
+/// The gap rule for a stream (samples fed one at a time: the Python `Estimator`, library users
+/// of the estimators): a step of t longer than kGapFactor periods, the period being the stream's
+/// nominal sample period (its median step is not known while it arrives; a whole record uses
+/// its median step, analyse_sampling). The caller restarts the estimator's regressors there.
+class StreamGaps {
+ public:
+  explicit StreamGaps(double period_s) noexcept : above_(kGapFactor * period_s) {}
+  /// Whether the sample at `t_s` starts a new stretch (never the first sample); remembers t_s.
+  bool gap_before(double t_s) noexcept {
+    const bool gap = seen_ && t_s - last_ > above_;
+    last_ = t_s;
+    seen_ = true;
+    return gap;
+  }
+  void reset() noexcept { seen_ = false; }
+
+ private:
+  double above_;
+  double last_ = 0.0;
+  bool seen_ = false;
+};
+
 /// Sampling of a strictly increasing time column.
 struct Sampling {
   double median_dt = 0.0;              ///< median of t[i] − t[i−1]
