@@ -278,6 +278,7 @@ MasterRun run_master_node(const BenchSettings& s, const MasterRunOptions& o, con
   const auto N = static_cast<std::int64_t>(control_steps);
   can::ControllerBus ctl(*bus, node_controller_config(loop.config().period_ns));
   std::size_t events_seen = 0, calibration_seen = 0;
+  double last_tet_us = 0.0;  // the previous step's TET [µs], for the console's status over XCP
   {
     const rt::DmaLatencyHold dma(o.loop.hold_dma_latency);
     out.stats.dma_latency_held = dma.held();
@@ -290,10 +291,9 @@ MasterRun run_master_node(const BenchSettings& s, const MasterRunOptions& o, con
         [&]() noexcept { ctl.pull(); },
         [&](std::size_t k, std::int64_t t_ns) noexcept {
           if (link) {  // console status over XCP: the previous step's TET, this step's wake-up latency
-            const auto rec = loop.records();
-            master.set_loop_figures(rec.empty() ? 0.0 : static_cast<double>(rec.back().tet_ns) * 1e-3,
+            master.set_loop_figures(last_tet_us,
                                     static_cast<double>(t_ns - static_cast<std::int64_t>(k) * loop.config().period_ns) * 1e-3,
-                                    static_cast<double>(loop.overruns().size()));
+                                    static_cast<double>(loop.overrun_count()));
           }
           const bool ok = master.step(ctl, static_cast<double>(t_ns) * 1e-9);
           return ok && master.control_steps() < N;
@@ -301,6 +301,7 @@ MasterRun run_master_node(const BenchSettings& s, const MasterRunOptions& o, con
         [&]() noexcept { ctl.flush(); },
         // After the timed cycle: hand the step's events, frames and row to the writer (never waits).
         [&](std::size_t, const rt::StepRecord& rec) noexcept {
+          last_tet_us = static_cast<double>(rec.tet_ns) * 1e-3;  // the records are streamed, not kept
           const auto ev = master.events();
           for (; events_seen < ev.size(); ++events_seen) writer.push(ev[events_seen]);
           const auto cal = master.calibration_events();

@@ -212,6 +212,8 @@ class PeriodicLoop {
   std::span<const OverrunEvent> overruns() const noexcept {
     return {overruns_.data(), n_overruns_ < overruns_.size() ? n_overruns_ : overruns_.size()};
   }
+  /// Every overrun so far (overruns() keeps at most the first kMaxOverrunEvents without records).
+  std::size_t overrun_count() const noexcept { return n_overruns_; }
   /// Statistics over the recorded steps [µs]: TET, wake-up latency, I/O time, and the cycle
   /// (I/O + TET: what the deadline is checked against, wake-up latency excluded).
   Summary tet_us() const { return rt::tet_us(records()); }
