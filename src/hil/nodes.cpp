@@ -403,6 +403,10 @@ bool MasterNode::step(can::Bus& bus, double now_s) noexcept {
     if (dto && cro_sent_) {
       handshake_s_ = now_s - first_cro_s_;
       reset_law();
+      // The sensor timeout counts from the connection: the steps spent waiting for the DTO are
+      // not missed sensor periods (the slave sends only once connected). A replay of the logs
+      // (hil simulate --schedule) starts at the connection too, so it must not see them either.
+      watch_ = InputWatch{};
       go(MasterState::connected, NodeEventKind::connected, now_s);
     } else if (cro_sent_ && now_s - first_cro_s_ >= cfg_.dto_timeout_s) {
       go(MasterState::failed, NodeEventKind::dto_timeout, now_s);

@@ -348,6 +348,30 @@ TEST(HilMaster, SafeStateAfterThreeMissedPeriodsAndResume) {
   EXPECT_EQ(master.log().back().integrator_mA, 0.0);  // forward Euler after a reset: I(0) = 0
 }
 
+// A slave slow to start: the master waits several steps for the DTO. Those steps are not missed
+// sensor periods: at the connection the master is in `connected`, not in the safe state, and a
+// replay of its schedule (which starts at the connection) agrees. The timeout then counts 3
+// periods from the connection (docs/hil.md).
+TEST(HilMaster, SensorTimeoutCountsFromTheConnection) {
+  const double T = 0.005;
+  BenchLayout L;
+  MasterNode master(L, master_config(T));
+  SlaveNode slave(L, slave_config(T));
+  MemLink link;
+  for (int i = 0; i < 5; ++i) master.step(link.a(), 0);  // CRO sent, no answer yet (5 > 3 periods)
+  ASSERT_EQ(master.state(), MasterState::startup);
+  ASSERT_TRUE(slave.wait_connect(link.b(), std::chrono::nanoseconds(0)));
+  master.step(link.a(), 0);  // the DTO: connected, no sensor frame yet
+  EXPECT_EQ(master.state(), MasterState::connected);
+  for (int miss = 1; miss <= 2; ++miss) {  // periods after the connection without a sensor frame
+    master.step(link.a(), 0);
+    EXPECT_EQ(master.state(), MasterState::connected) << miss;
+  }
+  master.step(link.a(), 0);  // the 3rd: the timeout
+  EXPECT_EQ(master.state(), MasterState::safe);
+  EXPECT_EQ(master.events().back().kind, MasterEventKind::sensor_timeout);
+}
+
 namespace {
 
 /// A command frame with the given raw SolenoidA code and counter, CRC right unless told.
