@@ -44,10 +44,10 @@ BENCHMARK(BM_PilotValvePlantSample);
 // One adaptive controller step of the valve scenario (docs/compensation.md): PID, the
 // input-deadzone estimator (IV, both sides in use), the gates and the deadzone inverse, on a
 // first-order plant with the 288/−296 mA deadzone driven by a 4 s sine reference.
-// state.range(0): 0 = the fixed inverse, 1 = adaptive (re-guessing and drift detection on):
-// side by side in one run (issue 24: adaptive within +2 us of fixed).
-void BM_ControllerStepFixedVsAdaptive(benchmark::State& state);
-void BM_AdaptiveControllerStep(benchmark::State& state) {
+// `mode`: the fixed inverse or adaptive (re-guessing and drift detection on);
+// BM_ControllerStepFixedVsAdaptive runs both side by side in one run (issue 24: adaptive
+// within +2 us of fixed), its state.range(0): 0 = fixed, 1 = adaptive.
+void compensated_loop(benchmark::State& state, CompensationMode mode) {
   PidConfig pc;
   pc.gains = {0.5, 10.0, 0.0, 0.0};
   pc.anti_windup = AntiWindup::clamp;
@@ -55,7 +55,7 @@ void BM_AdaptiveControllerStep(benchmark::State& state) {
   pc.output_max = 2000;
   Pid pid(pc);
   DeadzoneCompensationConfig cc;
-  cc.mode = CompensationMode::adaptive;
+  cc.mode = mode;
   cc.nominal.offset_right = 288.0;
   cc.nominal.offset_left = 296.0;
   cc.estimator.model = ModelKind::input_deadzone;
@@ -80,40 +80,11 @@ void BM_AdaptiveControllerStep(benchmark::State& state) {
     benchmark::DoNotOptimize(i);
   }
 }
+void BM_AdaptiveControllerStep(benchmark::State& state) { compensated_loop(state, CompensationMode::adaptive); }
 BENCHMARK(BM_AdaptiveControllerStep);
 
 void BM_ControllerStepFixedVsAdaptive(benchmark::State& state) {
-  PidConfig pc;
-  pc.gains = {0.5, 10.0, 0.0, 0.0};
-  pc.anti_windup = AntiWindup::clamp;
-  pc.output_min = -2000;
-  pc.output_max = 2000;
-  Pid pid(pc);
-  DeadzoneCompensationConfig cc;
-  cc.mode = state.range(0) == 0 ? CompensationMode::fixed : CompensationMode::adaptive;
-  cc.nominal.offset_right = 288.0;
-  cc.nominal.offset_left = 296.0;
-  cc.estimator.model = ModelKind::input_deadzone;
-  cc.estimator.guess_right = 432.0;
-  cc.estimator.guess_left = -444.0;
-  cc.estimator.rls.lambda = 0.995;
-  cc.estimator.method = EstimationMethod::iv;
-  DeadzoneCompensator comp(cc);
-  double y = 0.0, x = 0.0;
-  std::array<double, 800> ref{};
-  for (std::size_t j = 0; j < ref.size(); ++j) ref[j] = 600.0 * std::sin(1.5707963 * 0.005 * static_cast<double>(j));
-  std::size_t k = 0;
-  for (auto _ : state) {
-    const double r = ref[k];
-    k = k + 1 == ref.size() ? 0 : k + 1;
-    const double u = pid.step(r - y) + 0.465 * r;
-    const double i = comp.command(u);
-    comp.observe(i, y, true);
-    const double dz = i > 288.0 ? i - 288.0 : (i < -296.0 ? i + 296.0 : 0.0);
-    x = 0.93 * x + 0.07 * 2.15 * dz;
-    y = x;
-    benchmark::DoNotOptimize(i);
-  }
+  compensated_loop(state, state.range(0) == 0 ? CompensationMode::fixed : CompensationMode::adaptive);
 }
 BENCHMARK(BM_ControllerStepFixedVsAdaptive)->Arg(0)->Arg(1);
 

@@ -13,6 +13,7 @@
 #include "lash/hil/nodes.hpp"
 #include "lash/hil/netns.hpp"
 #include "lash/hil/xcp_server.hpp"
+#include "hil_master_fixture.hpp"
 
 #include <atomic>
 #include <thread>
@@ -22,61 +23,14 @@ namespace {
 using namespace lash;
 using namespace lash::hil;
 
-/// A bus that hands out one prepared frame per receive cycle and drops what is sent:
-/// no system calls, no allocation — isolates a node's own work.
-class ScriptedBus final : public can::Bus {
- public:
-  can::Frame next;
-  bool pending = false;
-  bool send(const can::Frame& f) noexcept override {
-    last_sent = f;
-    return true;
-  }
-  std::optional<can::Frame> receive(std::chrono::nanoseconds) noexcept override {
-    if (!pending) return std::nullopt;
-    pending = false;
-    return next;
-  }
-  void set_filters(std::vector<can::Filter>) override {}
-  can::BusStats stats() const noexcept override { return {}; }
-  std::string address() const override { return "scripted"; }
-  can::Frame last_sent;
-};
-
-can::Frame dto() {
-  can::Frame f;
-  f.id = 0x7E1;
-  f.len = 8;
-  f.data[0] = 0xFF;
-  return f;
-}
-
-MasterConfig master_cfg() {
-  MasterConfig m;
-  m.controller.pid.dt_s = 0.005;
-  m.controller.pid.gains = {1.2, 12.0, 0.004, 0.0};
-  m.reference.kind = Waveform::square;
-  m.reference.amplitude = 500;
-  m.reference.offset = 1000;
-  m.reference.frequency_rad_s = 3.0;
-  m.log_capacity = 1 << 16;
-  return m;
-}
-
-/// A master past its CCP handshake on `bus`.
-MasterNode connected_master(const BenchLayout& L, ScriptedBus& bus) {
-  MasterNode master(L, master_cfg());
-  master.step(bus, 0.0);  // CRO
-  bus.next = dto();
-  bus.pending = true;
-  master.step(bus, 0.0);  // connected
-  return master;
-}
+using bench::connected_master;
+using bench::dto;
+using bench::ScriptedBus;
 
 void BM_HilMasterStep(benchmark::State& state) {
   BenchLayout L;
   ScriptedBus bus;
-  MasterNode master = connected_master(L, bus);
+  MasterNode master = connected_master(L, bus, 0.005);
   std::uint16_t c = 0;
   for (auto _ : state) {
     bus.next = L.pack_sensors({static_cast<std::uint16_t>(17000 + (c & 255)), 0, c});
@@ -95,7 +49,7 @@ BENCHMARK(BM_HilMasterStep);
 void BM_HilMasterStepXcp(benchmark::State& state) {
   BenchLayout L;
   ScriptedBus bus;
-  MasterNode master = connected_master(L, bus);
+  MasterNode master = connected_master(L, bus, 0.005);
   auto link = std::make_unique<XcpLink>();
   master.attach(link.get());
   std::atomic<bool> stop{false};
@@ -209,7 +163,7 @@ BENCHMARK(BM_Crc8SaeJ1850NineBytes);
 void BM_HilMasterStepColdCache(benchmark::State& state) {
   BenchLayout L;
   ScriptedBus bus;
-  MasterNode master = connected_master(L, bus);
+  MasterNode master = connected_master(L, bus, 0.005);
   std::vector<unsigned char> junk(32u << 20);
   std::uint16_t c = 0;
   for (auto _ : state) {

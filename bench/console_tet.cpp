@@ -25,37 +25,13 @@
 #include "lash/console/server.hpp"
 #include "lash/hil/nodes.hpp"
 #include "lash/rt/periodic.hpp"
+#include "hil_master_fixture.hpp"
 
 namespace {
 using namespace lash;
 using namespace lash::hil;
 
-class ScriptedBus final : public can::Bus {  // one prepared frame per cycle; sends dropped
- public:
-  can::Frame next;
-  bool pending = false;
-  bool send(const can::Frame&) noexcept override { return true; }
-  std::optional<can::Frame> receive(std::chrono::nanoseconds) noexcept override {
-    if (!pending) return std::nullopt;
-    pending = false;
-    return next;
-  }
-  void set_filters(std::vector<can::Filter>) override {}
-  can::BusStats stats() const noexcept override { return {}; }
-  std::string address() const override { return "scripted"; }
-};
-
-MasterConfig master_cfg() {
-  MasterConfig m;
-  m.controller.pid.dt_s = 0.001;
-  m.controller.pid.gains = {1.2, 12.0, 0.004, 0.0};
-  m.reference.kind = Waveform::square;
-  m.reference.amplitude = 500;
-  m.reference.offset = 1000;
-  m.reference.frequency_rad_s = 3.0;
-  m.log_capacity = 1 << 16;
-  return m;
-}
+using bench::ScriptedBus;
 
 std::filesystem::path uplot_dir() {
   if (const char* e = std::getenv("LASH_UPLOT_DIR"); e && *e) return e;
@@ -82,15 +58,7 @@ int main(int argc, char** argv) {
   }
   BenchLayout L;
   ScriptedBus bus;
-  MasterNode master(L, master_cfg());
-  master.step(bus, 0.0);  // CCP CONNECT
-  can::Frame dto;
-  dto.id = 0x7E1;
-  dto.len = 8;
-  dto.data[0] = 0xFF;
-  bus.next = dto;
-  bus.pending = true;
-  master.step(bus, 0.0);  // connected
+  MasterNode master = bench::connected_master(L, bus, 0.001);
   auto link = std::make_unique<XcpLink>();
   master.attach(link.get());
 
