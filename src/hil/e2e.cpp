@@ -47,7 +47,11 @@ bool SeqTracker::on_counter(std::uint16_t counter) noexcept {
   candidate = counter;
   if (run >= sync_frames) {
     ++resyncs;
-    extended = counter;
+    // A forward jump: a gap of more than max_delta frames (a stalled receiver, frames lost) and a
+    // restarted sender look the same on the wire; taking it as a jump keeps `extended` monotone
+    // and congruent to the counter, so it goes on numbering a running sender's frames (which the
+    // replay of the logs needs, hil simulate --schedule). Ambiguous only past 2^bits lost frames.
+    extended += static_cast<std::uint16_t>((counter - last) & mask);
     return accept(counter);
   }
   drops.add(Drop::sequence);

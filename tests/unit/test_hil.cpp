@@ -183,6 +183,16 @@ TEST(HilSeq, EightBitWrapAndExtendedCounter) {
   EXPECT_FALSE(t.on_counter(5 + 200));  // 200 ahead: wrong sequence
   EXPECT_TRUE(t.on_counter(5 + 3));     // 6, 7 lost
   EXPECT_EQ(t.lost, 2u);
+  EXPECT_EQ(t.extended, 264u);
+  // A receiver stalled for 115 frames (frames 265..379 never seen): 380 = 124 mod 256 is a wrong
+  // sequence (dropped), 381 = 125 re-synchronises. The unwrapped counter goes on numbering the
+  // sender's frames (381), not the wire's 8-bit value (125).
+  EXPECT_FALSE(t.on_counter(380 & 0xFF));
+  EXPECT_TRUE(t.on_counter(381 & 0xFF));
+  EXPECT_EQ(t.resyncs, 1u);
+  EXPECT_EQ(t.extended, 381u);
+  EXPECT_TRUE(t.on_counter(382 & 0xFF));
+  EXPECT_EQ(t.extended, 382u);
 }
 
 // The simulation through the nodes and the bus equals a discrete loop written out by hand

@@ -93,7 +93,7 @@ struct SeqTracker {
   std::uint32_t max_delta = 10, sync_frames = 2;
   bool have = false;
   std::uint16_t last = 0;          ///< last accepted counter
-  std::uint64_t extended = 0;      ///< the accepted counter unwrapped (a restarted sender starts it again)
+  std::uint64_t extended = 0;      ///< the accepted counter unwrapped, monotone (a re-synchronisation is a forward jump)
   std::uint16_t candidate = 0;     ///< last counter of a wrong sequence
   std::uint32_t run = 0;           ///< frames in a row of that wrong sequence
   std::uint64_t received = 0, accepted = 0, late = 0, lost = 0, resyncs = 0;
