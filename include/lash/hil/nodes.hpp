@@ -138,7 +138,7 @@ class EventLog {
 // `lash hil run|simulate --scenario FILE --compensation MODE` (docs/compensation.md): the slave
 // emulates the E4 valve rig with the scenario's drifts, the master runs the scenario's
 // compensated law. `lash closed-loop --scenario` on a valve scenario runs these very nodes
-// (hil::simulate_bench), so its figures and the emulation's agree bit for bit.
+// (hil::BenchSimulation, schedule.hpp), so its figures and the emulation's agree bit for bit.
 
 /// Under a scenario the valve is driven both ways and its output is a pressure difference
 /// (rigs/pilot_valve_rig.hpp): the master sends a positive current as SolenoidA_Current and a
