@@ -9,7 +9,6 @@
 
 #include "cli_common.hpp"
 #include "csv_stream.hpp"
-#include "lash/io/memory.hpp"
 #include "plot.hpp"
 #include "lash/experiments/closed_loop_scenario.hpp"
 
@@ -31,13 +30,6 @@ int run_closed_loop_scenario_cmd(const std::string& path, const std::string& com
   if (!plot.empty()) {
     if (out.empty()) throw InputError("", 0, "--plot", "needs -o FILE (the plot is drawn from it)");
     check_output_path(plot, "--plot");
-  }
-  try {
-    require_memory(experiments::scenario_memory_bytes(s),
-                   fmt::format("duration_s = {} s at dt_s = {} s (the bench simulation's logs, at least)",
-                               format_double(s.duration_s), format_double(s.dt_s)));
-  } catch (const std::invalid_argument& e) {
-    throw InputError(path, 0, "duration_s", e.what());
   }
   const std::string y = valve ? "pressure_kPa" : "free_position_m";
   const std::string ref = valve ? "reference_kPa" : "reference_m";

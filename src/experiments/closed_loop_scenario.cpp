@@ -1,6 +1,7 @@
 #include "lash/experiments/closed_loop_scenario.hpp"
 
 #include <algorithm>
+#include <concepts>
 #include <cmath>
 #include <stdexcept>
 
@@ -10,9 +11,9 @@
 #include "lash/identify/config_file.hpp"
 #include "lash/identify/verdict.hpp"
 #include "lash/io/error.hpp"
-#include "lash/io/memory.hpp"
 #include "lash/io/toml_util.hpp"
 #include "lash/rigs/coupled_carts.hpp"
+#include "lash/rigs/drift.hpp"
 #include "lash/rigs/pilot_valve_rig.hpp"
 #include "lash/io/numeric.hpp"
 
@@ -269,79 +270,180 @@ namespace {
 
 double clamp(double x, double lo, double hi) noexcept { return x < lo ? lo : (x > hi ? hi : x); }
 
-// A ramp's rig: every real-valued parameter moved the share f of the way (only the drifted one
-// differs between a and b; x + (x − x)·f = x exactly for the others; f = 1 gives b exactly).
-double lerp(double a, double b, double f) noexcept { return f >= 1.0 ? b : a + (b - a) * f; }
-rigs::PilotValveRigParams lerp(const rigs::PilotValveRigParams& a, const rigs::PilotValveRigParams& b, double f) noexcept {
-  rigs::PilotValveRigParams p = a;
-  for (double rigs::PilotValveRigParams::*m :
-       {&rigs::PilotValveRigParams::deadzone_right_mA, &rigs::PilotValveRigParams::deadzone_left_mA,
-        &rigs::PilotValveRigParams::gain_right_kPa_mA, &rigs::PilotValveRigParams::gain_left_kPa_mA,
-        &rigs::PilotValveRigParams::tau0_s, &rigs::PilotValveRigParams::tau_half_pressure_kPa,
-        &rigs::PilotValveRigParams::solenoid_tau_s, &rigs::PilotValveRigParams::bias_kPa,
-        &rigs::PilotValveRigParams::noise_sigma_kPa, &rigs::PilotValveRigParams::quantum_kPa})
-    p.*m = lerp(a.*m, b.*m, f);
-  return p;
-}
-rigs::CoupledCartsParams lerp(const rigs::CoupledCartsParams& a, const rigs::CoupledCartsParams& b, double f) noexcept {
-  rigs::CoupledCartsParams p = a;
-  for (double rigs::CoupledCartsParams::*m :
-       {&rigs::CoupledCartsParams::free_mass_kg, &rigs::CoupledCartsParams::free_coulomb_N,
-        &rigs::CoupledCartsParams::free_static_N, &rigs::CoupledCartsParams::half_clearance_m,
-        &rigs::CoupledCartsParams::restitution, &rigs::CoupledCartsParams::lock_speed_m_s})
-    p.*m = lerp(a.*m, b.*m, f);
-  return p;
-}
-rigs::RigConfig lerp(const rigs::RigConfig& a, const rigs::RigConfig& b, double f) {
-  rigs::RigConfig c = b;
-  c.pilot_valve = lerp(a.pilot_valve, b.pilot_valve, f);
-  c.coupled_carts = lerp(a.coupled_carts, b.coupled_carts, f);
-  return c;
-}
-// A drift's first sample and its length in samples (0 = a step).
+// A drift's length in control steps (0 = a step).
 std::int64_t ramp_n(const Drift& d, double dt_s) { return std::llround(d.ramp_s / dt_s); }
 
+// The scenario's drifts of one rig's parameters as segments (rigs/drift.hpp): a ramp is one
+// segment, interpolated at each step (it was one entry per control step of the ramp).
+template <class Params>
+std::vector<rigs::DriftSegment<Params>> segments(const ClosedLoopScenario& s, Params rigs::RigConfig::*rig) {
+  std::vector<rigs::DriftSegment<Params>> out;
+  for (const Drift& d : s.drift) out.push_back({step_of(d.at_s, s.dt_s), ramp_n(d, s.dt_s), d.before.*rig, d.after.*rig});
+  return out;
+}
 
-// RMS and max of r − y over a window, sample by sample: the arithmetic of hil::tracking (the same
-// bits), without keeping the samples.
-struct TrackingAccumulator {
-  double dt_s, t0_s, t1_s;
-  double sum2 = 0.0;
-  hil::Tracking w;
-  void add(std::size_t m, double r, double y) noexcept {
-    const double t = static_cast<double>(m) * dt_s;
-    if (t < t0_s - 1e-12 || t > t1_s + 1e-12) return;
-    const double e = r - y;
-    sum2 += e * e;
-    w.max_abs_error = std::max(w.max_abs_error, std::fabs(e));
-    ++w.samples;
-  }
-  hil::Tracking result() const {
-    hil::Tracking out = w;
-    out.t0_s = t0_s;
-    out.t1_s = t1_s;
-    out.rms_error = w.samples ? std::sqrt(sum2 / static_cast<double>(w.samples)) : std::nan("");
-    return out;
-  }
+// ---------------------------------------------------------------------------------- the runner
+// One loop for both rigs (run() below): each control step k the rig's policy runs its law, its
+// plant and its sensor and reports one sample; the runner scores it (hil::ScenarioScore: the
+// window, before and after the first drift), hands it to the trace, and at the end reads the
+// compensator's state (hil::compensation_state). What differs between the rigs is only inside
+// the policies: the valve runs on the bench's nodes (the HIL master's law, the slave's rig), the
+// carts in process.
+
+// One control step's sample (a row of the trace).
+struct StepSample {
+  double r = 0.0, y = 0.0, command = 0.0, right = 0.0, left = 0.0, drive = 0.0;
 };
 
-// The compensator's end state: the parameters in use, the updates and the verdict per side.
-template <class Comp>
-void finish(ClosedLoopScenarioResult& res, const Comp& comp) {
-  const PerSide<double> used = comp.in_use();
-  res.final_right = used.right;
-  res.final_left = used.left;
-  res.updates = comp.updates();
-  res.reguesses_right = comp.adapter().reguesses(Side::right);
-  res.reguesses_left = comp.adapter().reguesses(Side::left);
-  res.guess_right = comp.adapter().guess(Side::right);
-  res.guess_left = comp.adapter().guess(Side::left);
-  res.events = comp.events();
-  res.reason = comp.reason();
-  res.estimator_identified = comp.adapter().identified(Side::right) && comp.adapter().identified(Side::left);
-  char reason[sizeof(hil::CompensationState::estimator_reason)];  // the master's (the same text)
-  both_sides_reason(reason, comp.estimator_reason(Side::right), comp.estimator_reason(Side::left));
-  res.estimator_reason = reason;
+template <class Rig>
+concept ScenarioRig = requires(Rig& rig, std::size_t k) {
+  { rig.step(k) } -> std::same_as<StepSample>;
+  { rig.compensation() } -> std::same_as<hil::CompensationState>;
+};
+
+// pilot_valve: the bench's master and slave nodes over the in-process link with the ideal
+// schedule (hil::BenchSimulation, one control step per step()): the same step code, timing and
+// bus quantisation as `lash hil run --scenario`, so that the figures agree bit for bit. The
+// slave applies the drifts and the master feeds the oracle from the same segments
+// (RigPlant::drift, CompensatedLaw::oracle). O(1) memory: the nodes keep one row each.
+class ValveBench {
+ public:
+  ValveBench(const ClosedLoopScenario& s, CompensationMode mode, std::size_t n)
+      : settings_(bench(s, mode)),
+        schedule_(hil::lazy_ideal_schedule(n)),
+        sink_{[this](const hil::MasterStepLog& l) { master_ = l; },
+              [this](const hil::SlaveStepLog& l) { slave_ = l; }},
+        sim_(layout_, hil::master_config(settings_, ""), hil::slave_config(settings_, layout_), schedule_, sink_) {}
+
+  // Control step k pairs the master's row of control step k with slave step k's pressure (the
+  // noise-free rig pressure, the y(k) the master's sensor frame carried with noise).
+  StepSample step(std::size_t k) {
+    if (!sim_.advance() || master_.control_step != static_cast<std::int64_t>(k) || slave_.step != k)
+      throw std::logic_error("closed-loop scenario: the bench simulation left the ideal schedule at control step " +
+                             std::to_string(k));
+    return {master_.reference_kPa, slave_.pressure_kPa, master_.current_mA,
+            master_.inverse_right_mA, master_.inverse_left_mA, 0.0};
+  }
+  hil::CompensationState compensation() { return sim_.finish().compensation; }
+  const hil::BenchScenario& scenario() const { return *settings_.scenario; }
+
+ private:
+  static hil::BenchSettings bench(const ClosedLoopScenario& s, CompensationMode mode) {
+    hil::BenchSettings b;
+    apply_to_bench(s, mode, b);
+    return b;
+  }
+  const hil::BenchLayout layout_;  // the layout of config/hydraulic_bench.dbc
+  hil::BenchSettings settings_;
+  hil::FrameSchedule schedule_;
+  hil::SimulationSink sink_;
+  hil::MasterStepLog master_;
+  hil::SlaveStepLog slave_;
+  hil::BenchSimulation sim_;
+};
+
+// coupled_carts: position control of the free cart through the clearance, in process. The
+// reference r is the free cart's desired position; the motor cart's target is w* = BI(r) (the
+// backlash compensator); v = sat(PID(w* − w) + k_ff·(w* − w*(k−1))/T); the compensator observes
+// (w, y). The drift segments move the rig, and the oracle gets the true half clearance, each step.
+class CartsLoop {
+ public:
+  CartsLoop(const ClosedLoopScenario& s, CompensationMode mode)
+      : s_(s),
+        comp_(config(s, mode)),
+        rig_(s.rig_config.coupled_carts, s.dt_s, s.seed),
+        pid_(s.pid),
+        ref_(s.reference, s.dt_s),
+        drift_(segments(s, &rigs::RigConfig::coupled_carts)),
+        truth_(s.rig_config.coupled_carts.half_clearance_m),
+        y_(rig_.free_position_m()),
+        w_(rig_.motor_position_m()) {}
+
+  StepSample step(std::size_t k) noexcept {
+    if (const rigs::CoupledCartsParams* p = cursor_.advance(drift_, static_cast<std::int64_t>(k))) {
+      rig_.set_params(*p);
+      truth_ = p->half_clearance_m;
+    }
+    comp_.set_oracle(truth_, truth_);  // oracle only (false otherwise)
+    const double r = ref_.next();
+    if (k == 0) {
+      comp_.reset(r);
+      wstar1_ = comp_.command(r);
+    }
+    const double wstar = comp_.command(r);
+    const double ff = s_.feedforward * (wstar - wstar1_) / s_.dt_s;  // velocity feedforward
+    wstar1_ = wstar;
+    const double v = clamp(pid_.step(wstar - w_) + ff, s_.command_min, s_.command_max);
+    comp_.observe(w_, y_, true);  // simulated: every sample fresh
+    const PerSide<double> used = comp_.in_use();
+    const StepSample out{r, y_, v, used.right, used.left, w_};
+    rig_.step(v);
+    y_ = rig_.free_position_m();
+    w_ = rig_.motor_position_m();
+    return out;
+  }
+  hil::CompensationState compensation() const noexcept { return hil::compensation_state(comp_); }
+
+ private:
+  static BacklashCompensationConfig config(const ClosedLoopScenario& s, CompensationMode mode) {
+    BacklashCompensationConfig cc;
+    cc.mode = mode;
+    cc.nominal = s.backlash;
+    cc.estimator = s.backlash_estimator;
+    cc.adaptation = s.adaptation;
+    cc.reguess = s.reguess;
+    return cc;
+  }
+  const ClosedLoopScenario& s_;
+  BacklashCompensator comp_;
+  rigs::CoupledCarts rig_;
+  Pid pid_;
+  Signal ref_;
+  std::vector<rigs::DriftSegment<rigs::CoupledCartsParams>> drift_;
+  rigs::DriftCursor<rigs::CoupledCartsParams> cursor_;
+  double truth_, y_, w_;
+  double wstar1_ = 0.0;
+};
+
+hil::BenchScenario score_spec(const ClosedLoopScenario& s, CompensationMode mode) {
+  hil::BenchScenario b;
+  b.file = s.file;
+  b.mode = mode;
+  b.score_t0_s = s.score_t0_s;
+  b.score_t1_s = s.score_t1_s;
+  b.first_drift_s = s.drift.empty() ? -1.0 : static_cast<double>(step_of(s.drift.front().at_s, s.dt_s)) * s.dt_s;
+  return b;
+}
+
+template <ScenarioRig Rig>
+ClosedLoopScenarioResult run(const ClosedLoopScenario& s, CompensationMode mode, std::size_t n, Rig& rig,
+                             const ScenarioRowFn& row) {
+  hil::ScenarioScore score(score_spec(s, mode), s.dt_s);
+  for (std::size_t k = 0; k < n; ++k) {
+    const StepSample x = rig.step(k);
+    score.add(k, x.r, x.y);
+    if (row) row({static_cast<double>(k) * s.dt_s, x.r, x.y, x.command, x.right, x.left, x.drive});
+  }
+  const hil::CompensationState c = rig.compensation();
+  const hil::ScenarioFigures f = score.result(c);
+  ClosedLoopScenarioResult res;
+  res.mode = mode;
+  res.samples = n;
+  res.rms_error = f.window.rms_error;
+  res.max_abs_error = f.window.max_abs_error;
+  res.final_right = c.right;
+  res.final_left = c.left;
+  res.updates = c.updates;
+  res.reguesses_right = c.reguesses_right;
+  res.reguesses_left = c.reguesses_left;
+  res.guess_right = c.guess_right;
+  res.guess_left = c.guess_left;
+  res.events = c.events;
+  res.reason = c.reason;
+  res.estimator_identified = c.estimator_identified;
+  res.estimator_reason = c.estimator_reason;
+  if (s.rig == rigs::RigKind::pilot_valve) res.bench = f;
+  return res;
 }
 
 }  // namespace
@@ -355,7 +457,11 @@ rigs::RigConfig rig_config_at(const ClosedLoopScenario& s, std::int64_t k) {
       c = d.after;
       continue;
     }
-    return lerp(d.before, d.after, static_cast<double>(k - k0) / static_cast<double>(n));
+    const double f = static_cast<double>(k - k0) / static_cast<double>(n);
+    c = d.after;
+    c.pilot_valve = rigs::lerp(d.before.pilot_valve, d.after.pilot_valve, f);
+    c.coupled_carts = rigs::lerp(d.before.coupled_carts, d.after.coupled_carts, f);
+    return c;
   }
   return c;
 }
@@ -370,18 +476,10 @@ void apply_to_bench(const ClosedLoopScenario& s, CompensationMode mode, hil::Ben
                      "the bench drives each solenoid with 0..2000 mA: [controller] min and max must lie in "
                      "-2000..2000 [mA]");
   b.set_step(s.dt_s);
-  hil::BenchScenario h;
-  h.file = s.file;
-  h.mode = mode;
+  hil::BenchScenario h = score_spec(s, mode);
   h.plant.params = s.rig_config.pilot_valve;
   h.plant.seed = s.seed;
-  // A ramp moves the rig once per control step (its changes at k0 + 1 … k0 + n; k0 is the value
-  // before): the slave's drift list holds n entries for it.
-  for (const Drift& d : s.drift) {
-    const std::int64_t k0 = step_of(d.at_s, s.dt_s), n = ramp_n(d, s.dt_s);
-    for (std::int64_t k = n == 0 ? k0 : k0 + 1; k <= k0 + n; ++k)
-      h.plant.drift.push_back({static_cast<std::uint32_t>(k), rig_config_at(s, k).pilot_valve});
-  }
+  h.plant.drift = segments(s, &rigs::RigConfig::pilot_valve);  // a ramp is one segment
   h.law.pid = s.pid;
   h.law.pid.dt_s = s.dt_s;
   h.law.feedforward = s.feedforward;
@@ -392,123 +490,21 @@ void apply_to_bench(const ClosedLoopScenario& s, CompensationMode mode, hil::Ben
   h.law.compensation.estimator = s.estimator;
   h.law.compensation.adaptation = s.adaptation;
   h.law.compensation.reguess = s.reguess;
-  if (mode == CompensationMode::oracle) {  // the rig's true edges, from the same schedule as the slave's
-    h.law.oracle.push_back({0, s.rig_config.pilot_valve.deadzone_right_mA, -s.rig_config.pilot_valve.deadzone_left_mA});
-    for (const auto& c : h.plant.drift)
-      h.law.oracle.push_back({static_cast<std::int64_t>(c.control_step), c.params.deadzone_right_mA, -c.params.deadzone_left_mA});
-  }
+  if (mode == CompensationMode::oracle) h.law.oracle = h.plant;  // the rig's true edges, the slave's drifts
   h.reference = s.reference;
   h.duration_s = s.duration_s;
-  h.score_t0_s = s.score_t0_s;
-  h.score_t1_s = s.score_t1_s;
-  h.first_drift_s = s.drift.empty() ? -1.0 : static_cast<double>(step_of(s.drift.front().at_s, s.dt_s)) * s.dt_s;
   b.scenario = std::move(h);
-}
-
-double scenario_memory_bytes(const ClosedLoopScenario& s) {
-  if (s.rig != rigs::RigKind::pilot_valve) return 0.0;
-  const double n = std::round(s.duration_s / s.dt_s) + 1.0;
-  return n * static_cast<double>(sizeof(hil::MasterStepLog) + sizeof(hil::SlaveStepLog) + 2 * sizeof(hil::FrameUse));
 }
 
 ClosedLoopScenarioResult run_closed_loop_scenario(const ClosedLoopScenario& s, CompensationMode mode,
                                                   const ScenarioRowFn& row) {
-  ClosedLoopScenarioResult res;
-  res.mode = mode;
-  const double dt = s.dt_s;
-  const auto n = static_cast<std::size_t>(step_of(s.duration_s, dt));
-  res.samples = n;
-  Signal ref(s.reference, dt);
-  Pid pid(s.pid);
-  std::size_t next_drift = 0;
-  auto drift_due = [&](std::size_t k) {
-    return next_drift < s.drift.size() && static_cast<std::int64_t>(k) >= step_of(s.drift[next_drift].at_s, dt);
-  };
+  const auto n = static_cast<std::size_t>(step_of(s.duration_s, s.dt_s));
   if (s.rig == rigs::RigKind::pilot_valve) {
-    // One engine: the bench's nodes over the in-process link (what `lash hil run` runs). Its
-    // logs are the bench's (hil); this runner keeps nothing of its own and streams the rows.
-    require_memory(scenario_memory_bytes(s),
-                   "a pilot_valve scenario of " + std::to_string(n) + " samples (the bench simulation's logs)");
-    hil::BenchSettings b;
-    apply_to_bench(s, mode, b);
-    const hil::BenchLayout L;  // the layout of config/hydraulic_bench.dbc
-    const hil::SimulationResult sim =
-        hil::simulate_bench(L, hil::master_config(b, ""), hil::slave_config(b, L), hil::ideal_schedule(n));
-    if (row)
-      for (std::size_t m = 0; m < n && m + 1 < sim.master.size() && m < sim.slave.size(); ++m) {
-        const auto& ml = sim.master[m + 1];  // master row 0 is the CONNECT step
-        row({static_cast<double>(m) * dt, ml.reference_kPa, sim.slave[m].pressure_kPa, ml.current_mA,
-             ml.inverse_right_mA, ml.inverse_left_mA, 0.0});
-      }
-    res.bench = hil::scenario_figures(*b.scenario, dt, sim.master, sim.slave, sim.compensation);
-    const hil::CompensationState& c = sim.compensation;
-    res.rms_error = res.bench->window.rms_error;
-    res.max_abs_error = res.bench->window.max_abs_error;
-    res.final_right = c.right;
-    res.final_left = c.left;
-    res.updates = c.updates;
-    res.reguesses_right = c.reguesses_right;
-    res.reguesses_left = c.reguesses_left;
-    res.guess_right = c.guess_right;
-    res.guess_left = c.guess_left;
-    res.events = c.events;
-    res.reason = c.reason;
-    res.estimator_identified = c.estimator_identified;
-    res.estimator_reason = c.estimator_reason;
-    return res;
+    ValveBench rig(s, mode, n);
+    return run(s, mode, n, rig, row);
   }
-  BacklashCompensationConfig cc;
-  cc.mode = mode;
-  cc.nominal = s.backlash;
-  cc.estimator = s.backlash_estimator;
-  cc.adaptation = s.adaptation;
-  cc.reguess = s.reguess;
-  BacklashCompensator comp(cc);
-  rigs::CoupledCarts rig(s.rig_config.coupled_carts, dt, s.seed);
-  TrackingAccumulator track{dt, s.score_t0_s, s.score_t1_s, 0.0, {}};
-  double y = rig.free_position_m(), w = rig.motor_position_m();
-  bool first = true;
-  double wstar1 = 0.0;
-  double truth = s.rig_config.coupled_carts.half_clearance_m;
-  for (std::size_t k = 0; k < n; ++k) {
-    const double t = static_cast<double>(k) * dt;
-    // a step: the drift's rig at its sample; a ramp: the rig once per sample until it ends
-    while (drift_due(k)) {
-      const Drift& d = s.drift[next_drift];
-      if (static_cast<std::int64_t>(k) < step_of(d.at_s, dt) + ramp_n(d, dt)) {
-        const rigs::RigConfig now = rig_config_at(s, static_cast<std::int64_t>(k));
-        rig.set_params(now.coupled_carts);
-        truth = now.coupled_carts.half_clearance_m;
-        break;
-      }
-      rig.set_params(d.after.coupled_carts);
-      truth = d.after.coupled_carts.half_clearance_m;
-      ++next_drift;
-    }
-    comp.set_oracle(truth, truth);  // oracle only (false otherwise)
-    const double r = ref.next();
-    if (first) {
-      comp.reset(r);
-      wstar1 = comp.command(r);
-      first = false;
-    }
-    const double wstar = comp.command(r);
-    const double ff = s.feedforward * (wstar - wstar1) / dt;  // velocity feedforward
-    wstar1 = wstar;
-    const double v = clamp(pid.step(wstar - w) + ff, s.command_min, s.command_max);
-    comp.observe(w, y, true);  // simulated: every sample fresh
-    const PerSide<double> used = comp.in_use();
-    track.add(k, r, y);
-    if (row) row({t, r, y, v, used.right, used.left, w});
-    rig.step(v);
-    y = rig.free_position_m();
-    w = rig.motor_position_m();
-  }
-  finish(res, comp);
-  const hil::Tracking tw = track.result();
-  res.rms_error = tw.rms_error;
-  res.max_abs_error = tw.max_abs_error;
-  return res;
+  CartsLoop rig(s, mode);
+  return run(s, mode, n, rig, row);
 }
 
 }  // namespace lash::experiments

@@ -78,7 +78,10 @@ SlaveNode::SlaveNode(const BenchLayout& layout, SlaveConfig config)
   plant_.reset(0.0);
   if (cfg_.rig) {
     cfg_.rig->params.validate();
-    for (const auto& c : cfg_.rig->drift) c.params.validate();
+    for (const auto& c : cfg_.rig->drift) {
+      c.before.validate();
+      c.after.validate();
+    }
     rig_.emplace(cfg_.rig->params, cfg_.plant.dt_s, cfg_.rig->seed);
   }
   log_.resize(cfg_.log_capacity);
@@ -201,9 +204,9 @@ void SlaveNode::step(can::Bus& bus, double now_s) noexcept {
   double y = 0.0, p_true = 0.0;
   std::uint16_t raw = 0;
   if (rig_) {
-    const auto& drift = cfg_.rig->drift;
-    while (next_drift_ < drift.size() && step_ >= drift[next_drift_].control_step + 1)
-      rig_->set_params(drift[next_drift_++].params);
+    if (step_ >= 1)
+      if (const rigs::PilotValveRigParams* p = drift_.advance(cfg_.rig->drift, static_cast<std::int64_t>(step_) - 1))
+        rig_->set_params(*p);
     // The rig's bias-corrected pressure difference, offset into the sensor code's range.
     raw = encode_pressure_raw(rig_->step(i) + kScenarioPressureZero_kPa);
     y = decode_pressure_raw(raw) - kScenarioPressureZero_kPa;
@@ -487,9 +490,13 @@ double MasterNode::law(double r, double y) noexcept {
   if (!comp_) return controller_.step(r, y);
   const CompensatedLaw& c = *cfg_.law;
   const double u = pid_->step(r - y) + c.feedforward * r;
-  while (next_oracle_ < c.oracle.size() && c.oracle[next_oracle_].control_step <= m_) {
-    comp_->set_oracle(c.oracle[next_oracle_].right_mA, c.oracle[next_oracle_].left_mA);
-    ++next_oracle_;
+  if (c.oracle) {  // the plant's true edges of this control step (rigs/drift.hpp)
+    if (!oracle_started_) {
+      comp_->set_oracle(c.oracle->params.deadzone_right_mA, -c.oracle->params.deadzone_left_mA);
+      oracle_started_ = true;
+    }
+    if (const rigs::PilotValveRigParams* p = oracle_.advance(c.oracle->drift, m_))
+      comp_->set_oracle(p->deadzone_right_mA, -p->deadzone_left_mA);
   }
   double i = comp_->command(u);
   i = i < c.command_min ? c.command_min : (i > c.command_max ? c.command_max : i);
@@ -504,25 +511,7 @@ void MasterNode::reset_law() noexcept {
 }
 
 CompensationState MasterNode::compensation() const noexcept {
-  CompensationState c;
-  if (!comp_) return c;
-  c.on = true;
-  c.mode = comp_->config().mode;  // as calibrated (docs/xcp.md)
-  if (c.mode != CompensationMode::none) {
-    c.right = comp_->inverse().params().offset_right;
-    c.left = -comp_->inverse().params().offset_left;
-  }
-  c.updates = comp_->updates();
-  c.reguesses_right = comp_->adapter().reguesses(Side::right);
-  c.reguesses_left = comp_->adapter().reguesses(Side::left);
-  c.guess_right = comp_->adapter().guess(Side::right);
-  c.guess_left = comp_->adapter().guess(Side::left);
-  c.events = comp_->events();
-  c.reason = comp_->reason();
-  c.estimator_identified = comp_->estimator().params(Side::right).identified &&
-                           comp_->estimator().params(Side::left).identified;
-  both_sides_reason(c.estimator_reason, comp_->estimator_reason(Side::right), comp_->estimator_reason(Side::left));
-  return c;
+  return comp_ ? compensation_state(*comp_) : CompensationState{};
 }
 
 // One control step in states connected..safe: sets current_mA_.

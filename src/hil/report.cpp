@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 
 #include "json_parts.hpp"
@@ -152,44 +153,85 @@ std::size_t off_schedule_steps(const std::vector<MasterStepLog>& master, const s
   return off.size();
 }
 
+void TrackingAccumulator::add(std::size_t m, double r, double y) noexcept {
+  const double t = static_cast<double>(m) * dt_s_;
+  if (t < w_.t0_s - 1e-12 || t > w_.t1_s + 1e-12) return;
+  const double e = r - y;
+  sum2_ += e * e;
+  w_.max_abs_error = std::max(w_.max_abs_error, std::fabs(e));
+  ++w_.samples;
+}
+
+Tracking TrackingAccumulator::result() const noexcept {
+  Tracking w = w_;
+  w.rms_error = w.samples ? std::sqrt(sum2_ / static_cast<double>(w.samples)) : std::nan("");
+  return w;
+}
+
 Tracking tracking(const std::vector<double>& reference, const std::vector<double>& output, double dt_s, double t0_s,
                   double t1_s) {
-  Tracking w;
-  w.t0_s = t0_s;
-  w.t1_s = t1_s;
-  double sum2 = 0.0;
+  TrackingAccumulator a(dt_s, t0_s, t1_s);
   const std::size_t n = std::min(reference.size(), output.size());
-  for (std::size_t m = 0; m < n; ++m) {
-    const double t = static_cast<double>(m) * dt_s;
-    if (t < t0_s - 1e-12 || t > t1_s + 1e-12) continue;
-    const double e = reference[m] - output[m];
-    sum2 += e * e;
-    w.max_abs_error = std::max(w.max_abs_error, std::fabs(e));
-    ++w.samples;
+  for (std::size_t m = 0; m < n; ++m) a.add(m, reference[m], output[m]);
+  return a.result();
+}
+
+namespace {
+// [0, drift): the last sample before the drift's control step.
+double before_end_s(double first_drift_s, double dt_s) {
+  return static_cast<double>(std::llround(first_drift_s / dt_s) - 1) * dt_s;
+}
+}  // namespace
+
+ScenarioScore::ScenarioScore(const BenchScenario& s, double dt_s) noexcept
+    : file_(s.file),
+      mode_(s.mode),
+      dt_s_(dt_s),
+      first_drift_s_(s.first_drift_s),
+      window_(dt_s, s.score_t0_s, s.score_t1_s),
+      before_(dt_s, 0.0, s.first_drift_s >= 0 ? before_end_s(s.first_drift_s, dt_s) : 0.0),
+      after_(dt_s, s.first_drift_s, std::numeric_limits<double>::infinity()) {}
+
+void ScenarioScore::add(std::size_t m, double r, double y) noexcept {
+  window_.add(m, r, y);
+  if (first_drift_s_ >= 0) {
+    before_.add(m, r, y);
+    after_.add(m, r, y);
   }
-  w.rms_error = w.samples ? std::sqrt(sum2 / static_cast<double>(w.samples)) : std::nan("");
-  return w;
+  samples_ = m + 1;
+}
+
+ScenarioFigures ScenarioScore::result(const CompensationState& compensation) const {
+  ScenarioFigures f;
+  f.file = file_;
+  f.mode = mode_;
+  f.window = window_.result();
+  const double end = static_cast<double>(samples_) * dt_s_;
+  if (first_drift_s_ >= 0) {  // a run that ended before the drift has no "after"
+    f.before_drift = before_.result();
+    if (first_drift_s_ < end) {
+      Tracking a = after_.result();
+      a.t1_s = end;  // every sample added lies before the end
+      f.after_drift = a;
+    }
+  }
+  f.compensation = compensation;
+  return f;
 }
 
 ScenarioFigures scenario_figures(const BenchScenario& s, double dt_s, const std::vector<MasterStepLog>& master,
                                  const std::vector<SlaveStepLog>& slave, const CompensationState& compensation) {
-  std::vector<double> ref, y;
-  for (const auto& l : master)
-    if (l.control_step >= 0) ref.push_back(l.reference_kPa);
-  for (const auto& l : slave) y.push_back(l.pressure_kPa);
-  ScenarioFigures f;
-  f.file = s.file;
-  f.mode = s.mode;
-  f.window = tracking(ref, y, dt_s, s.score_t0_s, s.score_t1_s);
-  const double end = static_cast<double>(std::min(ref.size(), y.size())) * dt_s;
-  if (s.first_drift_s >= 0) {  // a run that ended before the drift has no "after"
-    // [0, drift): the last sample before the drift's control step.
-    const double before_end = static_cast<double>(std::llround(s.first_drift_s / dt_s) - 1) * dt_s;
-    f.before_drift = tracking(ref, y, dt_s, 0.0, before_end);
-    if (s.first_drift_s < end) f.after_drift = tracking(ref, y, dt_s, s.first_drift_s, end);
+  // Control step m pairs the master's r(m) with slave step m's pressure.
+  ScenarioScore score(s, dt_s);
+  std::size_t m = 0;
+  auto ml = master.begin();
+  for (const auto& sl : slave) {
+    while (ml != master.end() && ml->control_step < 0) ++ml;
+    if (ml == master.end()) break;
+    score.add(m++, ml->reference_kPa, sl.pressure_kPa);
+    ++ml;
   }
-  f.compensation = compensation;
-  return f;
+  return score.result(compensation);
 }
 
 NodeFigures node_figures(const NodeStats& stats, const LoopTrace& loop) {

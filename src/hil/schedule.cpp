@@ -11,7 +11,6 @@
 #include "lash/io/table.hpp"
 
 namespace lash::hil {
-namespace {
 
 /// A node's bus in the replay: it receives what the replay queued for its step and keeps what it sent.
 class FeedBus final : public can::Bus {
@@ -38,6 +37,7 @@ class FeedBus final : public can::Bus {
   can::BusStats stats_;
 };
 
+namespace {
 /// A frame with the message's identifier and a wrong length: dropped by the DLC check.
 can::Frame implausible(can::Frame f) {
   f.len = f.len > 0 ? static_cast<std::uint8_t>(f.len - 1) : 1;
@@ -47,6 +47,8 @@ can::Frame implausible(can::Frame f) {
 std::string step_name(const char* node, std::int64_t step) {
   return std::string(node) + (node[0] == 'm' ? " control step " : " step ") + std::to_string(step);
 }
+
+}  // namespace
 
 /// The frames one node sent, numbered 0, 1, …; those a receiver has used are let go.
 class FrameHistory {
@@ -66,6 +68,7 @@ class FrameHistory {
   std::int64_t base_ = 0;
 };
 
+namespace {
 /// Queues what a node received at a step that used frame `use.seq` after `last` (and sets last).
 void feed(FeedBus& bus, const FrameUse& use, std::int64_t& last, FrameHistory& sent,
           const can::Frame& bad, const char* node, std::int64_t step) {
@@ -222,79 +225,109 @@ SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& m
   return s;
 }
 
-SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& master_cfg,
-                                const SlaveConfig& slave_cfg, const FrameSchedule& schedule,
-                                const SimulationSink& sink) {
-  const std::size_t N = schedule.master_steps();
-  MasterConfig mc = master_cfg;
+namespace {
+MasterConfig streaming(MasterConfig mc, const FrameSchedule& schedule) {
   mc.log_capacity = 1;  // one row, handed to the sink after each step
   mc.bus_log_capacity = 1;
   if (!schedule.calibration.empty()) mc.calibration_schedule = schedule.calibration;
-  SlaveConfig sc = slave_cfg;
+  return mc;
+}
+SlaveConfig streaming(SlaveConfig sc) {
   sc.log_capacity = 1;
-  MasterNode master(layout, mc);
-  SlaveNode slave(layout, sc);
-  auto master_step = [&](can::Bus& bus, double t) {
-    const bool ok = master.step(bus, t);
-    if (!master.log().empty() && sink.master) sink.master(master.log()[0]);
-    master.clear_step_logs();
-    return ok;
-  };
-  const double T = mc.controller.pid.dt_s;
-  FeedBus mb, sb;
+  return sc;
+}
+}  // namespace
+
+BenchSimulation::BenchSimulation(const BenchLayout& layout, const MasterConfig& master_cfg,
+                                 const SlaveConfig& slave_cfg, const FrameSchedule& schedule,
+                                 const SimulationSink& sink)
+    : layout_(layout),
+      schedule_(schedule),
+      sink_(sink),
+      master_(layout, streaming(master_cfg, schedule)),
+      slave_(layout, streaming(slave_cfg)),
+      T_(master_cfg.controller.pid.dt_s),
+      mb_(std::make_unique<FeedBus>()),
+      sb_(std::make_unique<FeedBus>()),
+      sensors_(std::make_unique<FrameHistory>()),
+      commands_(std::make_unique<FrameHistory>()),
+      bad_sensor_(implausible(layout.pack_sensors(SensorMsg{}))),
+      bad_command_(implausible(layout.pack_command(CommandMsg{}))) {
   // Handshake: CRO → slave, DTO → master.
-  master_step(mb, 0.0);
-  sb.in.assign(mb.out.begin(), mb.out.end());
-  mb.out.clear();
-  if (!slave.wait_connect(sb, std::chrono::nanoseconds(0)))
+  master_step(*mb_, 0.0);
+  sb_->in.assign(mb_->out.begin(), mb_->out.end());
+  mb_->out.clear();
+  if (!slave_.wait_connect(*sb_, std::chrono::nanoseconds(0)))
     throw std::invalid_argument("hil simulate: the slave did not see the master's CCP CONNECT");
-  mb.in.assign(sb.out.begin(), sb.out.end());
-  sb.out.clear();
+  mb_->in.assign(sb_->out.begin(), sb_->out.end());
+  sb_->out.clear();
+}
 
-  const can::Frame bad_sensor = implausible(layout.pack_sensors(SensorMsg{}));
-  const can::Frame bad_command = implausible(layout.pack_command(CommandMsg{}));
-  FrameHistory sensors, commands;  // sent by slave step s / control step m
-  std::int64_t m = 0, s = 0, m_used = -1, s_used = -1;
-  const auto S = static_cast<std::int64_t>(schedule.slave_steps());
-  auto slave_ready = [&] {
-    return s < S && schedule.slave_use(static_cast<std::size_t>(s)).seq < commands.size();
-  };
-  auto slave_step = [&] {
-    feed(sb, schedule.slave_use(static_cast<std::size_t>(s)), s_used, commands, bad_command, "slave", s);
-    slave.step(sb, (static_cast<double>(s) + 0.5) * T);
-    if (!slave.log().empty() && sink.slave) sink.slave(slave.log()[0]);
-    slave.clear_step_log();
-    collect(sb, layout.sensors_id, sensors);
-    ++s;
-  };
-  while (m < static_cast<std::int64_t>(N)) {
-    const FrameUse u = schedule.master_use(static_cast<std::size_t>(m));
-    if (u.seq < s) {
-      feed(mb, u, m_used, sensors, bad_sensor, "master", m);
-      if (!master_step(mb, static_cast<double>(m + 1) * T)) break;
-      collect(mb, layout.command_id, commands);
-      ++m;
-    } else if (slave_ready()) {
-      slave_step();
-    } else {
+BenchSimulation::~BenchSimulation() = default;
+
+void BenchSimulation::master_step(can::Bus& bus, double t) {
+  ok_ = master_.step(bus, t);
+  if (!master_.log().empty() && sink_.master) sink_.master(master_.log()[0]);
+  master_.clear_step_logs();
+}
+
+bool BenchSimulation::slave_ready() const {
+  return s_ < static_cast<std::int64_t>(schedule_.slave_steps()) &&
+         schedule_.slave_use(static_cast<std::size_t>(s_)).seq < commands_->size();
+}
+
+void BenchSimulation::slave_step() {
+  feed(*sb_, schedule_.slave_use(static_cast<std::size_t>(s_)), s_used_, *commands_, bad_command_, "slave", s_);
+  slave_.step(*sb_, (static_cast<double>(s_) + 0.5) * T_);
+  if (!slave_.log().empty() && sink_.slave) sink_.slave(slave_.log()[0]);
+  slave_.clear_step_log();
+  collect(*sb_, layout_.sensors_id, *sensors_);
+  ++s_;
+}
+
+bool BenchSimulation::advance() {
+  if (!ok_ || m_ >= static_cast<std::int64_t>(schedule_.master_steps())) return false;
+  const FrameUse u = schedule_.master_use(static_cast<std::size_t>(m_));
+  while (u.seq >= s_) {
+    if (!slave_ready()) {
+      const auto S = static_cast<std::int64_t>(schedule_.slave_steps());
       throw std::invalid_argument(
-          "hil schedule: not causal: master control step " + std::to_string(m) + " uses slave frame " +
-          std::to_string(u.seq) + ", but slave step " + std::to_string(s) +
-          (s < S ? " uses command " + std::to_string(schedule.slave_use(static_cast<std::size_t>(s)).seq) +
-                       " of a later control step"
-                 : " is past the end of the slave's schedule (" + std::to_string(S) + " steps)"));
+          "hil schedule: not causal: master control step " + std::to_string(m_) + " uses slave frame " +
+          std::to_string(u.seq) + ", but slave step " + std::to_string(s_) +
+          (s_ < S ? " uses command " + std::to_string(schedule_.slave_use(static_cast<std::size_t>(s_)).seq) +
+                        " of a later control step"
+                  : " is past the end of the slave's schedule (" + std::to_string(S) + " steps)"));
     }
+    slave_step();
   }
-  // The slave steps of the control steps run (for the plant pressure of each control step).
-  while (s < static_cast<std::int64_t>(N) && slave_ready()) slave_step();
-  if (N > 0 && (master.state() == MasterState::startup || master.state() == MasterState::failed))
-    throw std::invalid_argument(std::string("hil simulate: the master ended in state ") + to_string(master.state()) +
-                                " (is the recorded DTO a positive CONNECT reply?)");
+  feed(*mb_, u, m_used_, *sensors_, bad_sensor_, "master", m_);
+  master_step(*mb_, static_cast<double>(m_ + 1) * T_);
+  if (!ok_) return false;
+  collect(*mb_, layout_.command_id, *commands_);
+  ++m_;
+  return true;
+}
 
+SimulationResult BenchSimulation::finish() {
+  // The slave steps of the control steps run (for the plant pressure of each control step).
+  const auto N = static_cast<std::int64_t>(schedule_.master_steps());
+  while (s_ < N && slave_ready()) slave_step();
+  if (N > 0 && (master_.state() == MasterState::startup || master_.state() == MasterState::failed))
+    throw std::invalid_argument(std::string("hil simulate: the master ended in state ") + to_string(master_.state()) +
+                                " (is the recorded DTO a positive CONNECT reply?)");
   SimulationResult r;
-  r.compensation = master.compensation();
-  r.events.assign(master.events().begin(), master.events().end());
+  r.compensation = master_.compensation();
+  r.events.assign(master_.events().begin(), master_.events().end());
   return r;
+}
+
+SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& master_cfg,
+                                const SlaveConfig& slave_cfg, const FrameSchedule& schedule,
+                                const SimulationSink& sink) {
+  BenchSimulation sim(layout, master_cfg, slave_cfg, schedule, sink);
+  while (sim.advance()) {
+  }
+  return sim.finish();
 }
 
 }  // namespace lash::hil

@@ -245,7 +245,7 @@ TEST(HilSimulate, ScenarioEqualsHandWrittenLoopWithDriftAndBothSolenoids) {
   plant.seed = 7;
   rigs::PilotValveRigParams drifted = plant.params;
   drifted.deadzone_right_mA = 380.0;
-  plant.drift.push_back({200, drifted});
+  plant.drift.push_back({200, 0, plant.params, drifted});
   CompensatedLaw law;
   law.pid.dt_s = T;
   law.pid.gains.kp = 0.5;

@@ -13,6 +13,8 @@
 #include "lash/control/gains_file.hpp"
 #include "lash/experiments/closed_loop_scenario.hpp"
 #include "lash/hil/report.hpp"
+#include "lash/hil/settings.hpp"
+#include "lash/rigs/drift.hpp"
 #include "lash/io/memory.hpp"
 #include "lash/metrics/step_response.hpp"
 #include "lash/plant/plant_file.hpp"
@@ -295,10 +297,98 @@ TEST(ScenarioStream, CartsTrackingEqualsTheFiguresOfTheStreamedRows) {
   EXPECT_EQ(res.rms_error, w.rms_error);
   EXPECT_EQ(res.max_abs_error, w.max_abs_error);
   EXPECT_GT(w.samples, 7000u);
-  EXPECT_EQ(experiments::scenario_memory_bytes(s), 0.0);
   // No row asked for: the same figures.
   const auto res2 = experiments::run_closed_loop_scenario(s, CompensationMode::fixed);
   EXPECT_EQ(res2.rms_error, res.rms_error);
+}
+
+// The valve runs on the bench's nodes one control step at a time: every row streamed, the
+// figures accumulated on the way equal to a hand computation over the rows (window, before and
+// after the drift), the same as the nodes' logs (hil::simulate_bench) and with the rig's true
+// edges in use at each step under the oracle (the slave and the master walk the same ramp).
+TEST(ScenarioStream, ValveFiguresEqualAHandComputationOverTheStreamedRows) {
+  experiments::ClosedLoopScenario s =
+      experiments::load_closed_loop_scenario(kSrc + "/config/scenarios/closed_loop/valve_slow_ramp.toml");
+  s.duration_s = 20.0;
+  s.score_t0_s = 12.0;
+  s.score_t1_s = 20.0;
+  s.drift[0].at_s = 4.0;
+  s.drift[0].ramp_s = 8.0;  // 1600 control steps, edge 288 -> 380 mA
+  std::vector<experiments::ClosedLoopScenarioRow> rows;
+  const auto res = experiments::run_closed_loop_scenario(
+      s, CompensationMode::oracle, [&](const experiments::ClosedLoopScenarioRow& r) { rows.push_back(r); });
+  ASSERT_EQ(rows.size(), 4000u);
+  ASSERT_EQ(res.samples, 4000u);
+  ASSERT_TRUE(res.bench.has_value());
+  // By hand: RMS and max of r − y with sample m at t = m·5 ms in [t0, t1] (both ends included).
+  auto by_hand = [&](std::size_t m0, std::size_t m1, const hil::Tracking& got) {
+    double sum2 = 0.0, mx = 0.0;
+    for (std::size_t m = m0; m <= m1; ++m) {
+      const double e = rows[m].reference - rows[m].output;
+      sum2 += e * e;
+      mx = std::max(mx, std::fabs(e));
+    }
+    EXPECT_EQ(got.samples, m1 - m0 + 1);
+    EXPECT_NEAR(got.rms_error, std::sqrt(sum2 / static_cast<double>(m1 - m0 + 1)), 1e-12 * got.rms_error);
+    EXPECT_EQ(got.max_abs_error, mx);
+  };
+  by_hand(2400, 3999, res.bench->window);  // [12, 20] s
+  EXPECT_EQ(res.rms_error, res.bench->window.rms_error);
+  ASSERT_TRUE(res.bench->before_drift && res.bench->after_drift);
+  by_hand(0, 799, *res.bench->before_drift);  // [0, 4) s
+  by_hand(800, 3999, *res.bench->after_drift);  // [4, 20] s
+  // The oracle's inverse: the rig's true right edge of each control step, the ramp interpolated
+  // in place: 288 mA up to step 800, 288 + 92·(k − 800)/1600 on the ramp, 380 mA from step 2400.
+  for (std::size_t k : {0u, 799u, 800u, 801u, 1600u, 2399u, 2400u, 3999u}) {
+    const double f = k <= 800 ? 0.0 : (k >= 2400 ? 1.0 : (static_cast<double>(k) - 800.0) / 1600.0);
+    EXPECT_NEAR(rows[k].param_right, 288.0 + 92.0 * f, 1e-9) << "k = " << k;
+    EXPECT_EQ(rows[k].param_left, -296.0) << "k = " << k;
+  }
+  // The bench holds the ramp as one segment (it held one rig change per control step).
+  hil::BenchSettings b;
+  experiments::apply_to_bench(s, CompensationMode::oracle, b);
+  ASSERT_EQ(b.scenario->plant.drift.size(), 1u);
+  EXPECT_EQ(b.scenario->plant.drift[0].k0, 800);
+  EXPECT_EQ(b.scenario->plant.drift[0].n, 1600);
+  ASSERT_TRUE(b.scenario->law.oracle.has_value());
+}
+
+// rigs::DriftCursor walks the segments to the values of rig_config_at (the direct formula) at
+// every step, reporting a change exactly where the rig changes: a ramp's steps k0 + 1 … k0 + n
+// and a step's k0, also when a step follows a ramp at its last step and when k jumps.
+TEST(ScenarioStream, DriftCursorWalksTheValuesOfRigConfigAt) {
+  experiments::ClosedLoopScenario s =
+      experiments::load_closed_loop_scenario(kSrc + "/config/scenarios/closed_loop/valve_slow_ramp.toml");
+  s.dt_s = 1.0;
+  s.duration_s = 100.0;
+  experiments::Drift ramp = s.drift[0];  // 288 -> 380 mA over [10, 20]
+  ramp.at_s = 10.0;
+  ramp.ramp_s = 10.0;
+  experiments::Drift step = ramp;  // then a step to 300 mA at 20 (where the ramp ends)
+  step.at_s = 20.0;
+  step.ramp_s = 0.0;
+  step.before = ramp.after;
+  step.after = ramp.after;
+  step.after.pilot_valve.deadzone_right_mA = 300.0;
+  s.drift = {ramp, step};
+  std::vector<rigs::DriftSegment<rigs::PilotValveRigParams>> seg;
+  for (const auto& d : s.drift)
+    seg.push_back({std::llround(d.at_s), std::llround(d.ramp_s), d.before.pilot_valve, d.after.pilot_valve});
+  rigs::DriftCursor<rigs::PilotValveRigParams> c;
+  double now = 288.0;
+  for (std::int64_t k = 0; k < 40; ++k) {
+    const rigs::PilotValveRigParams* p = c.advance(seg, k);
+    EXPECT_EQ(p != nullptr, k >= 11 && k <= 20) << "k = " << k;
+    if (p) now = p->deadzone_right_mA;
+    EXPECT_EQ(now, experiments::rig_config_at(s, k).pilot_valve.deadzone_right_mA) << "k = " << k;
+  }
+  EXPECT_EQ(now, 300.0);
+  EXPECT_DOUBLE_EQ(experiments::rig_config_at(s, 15).pilot_valve.deadzone_right_mA, 334.0);  // (288 + 380)/2
+  rigs::DriftCursor<rigs::PilotValveRigParams> jump;  // k jumps into the ramp, then past the step
+  ASSERT_NE(jump.advance(seg, 15), nullptr);
+  EXPECT_DOUBLE_EQ(jump.advance(seg, 16)->deadzone_right_mA, 288.0 + 92.0 * 0.6);
+  EXPECT_EQ(jump.advance(seg, 30)->deadzone_right_mA, 300.0);
+  EXPECT_EQ(jump.advance(seg, 31), nullptr);
 }
 
 }  // namespace

@@ -24,6 +24,7 @@
 #include "lash/control/adaptive_compensator.hpp"
 #include "lash/control/pid.hpp"
 #include "lash/hil/report.hpp"
+#include "lash/hil/schedule.hpp"
 #include "lash/hil/settings.hpp"
 #include "lash/rigs/rig.hpp"
 #include "lash/signals/signal.hpp"
@@ -70,7 +71,8 @@ struct ClosedLoopScenario {
 
 /// The rig's parameters at sample k of a run: the drifts applied, a ramp interpolated linearly
 /// per sample (f = (k − k0)/n, k0 = round(at_s/dt_s), n = round(ramp_s/dt_s); f = 1 gives the
-/// drift's value exactly). O(number of drifts).
+/// drift's value exactly; rigs::lerp). O(number of drifts); the runs walk the same values with a
+/// rigs::DriftCursor.
 rigs::RigConfig rig_config_at(const ClosedLoopScenario& s, std::int64_t k);
 
 /// Reads a scenario TOML (keys in docs/compensation.md). Throws InputError (file:line:key).
@@ -101,7 +103,8 @@ struct ClosedLoopScenarioResult {
   std::string estimator_reason;  ///< the estimator's side of the verdict
   bool estimator_identified = false;
   std::size_t samples = 0;       ///< samples run
-  /// pilot_valve: the bench's figures (tracking over the window and before/after the first drift).
+  /// pilot_valve: the scenario's figures of the bench's report (tracking over the window and
+  /// before/after the first drift; the runner computes them for both rigs, the carts do not report them).
   std::optional<hil::ScenarioFigures> bench;
 };
 
@@ -111,21 +114,18 @@ struct ClosedLoopScenarioResult {
 /// [controller] min below −2000 or max above 2000 mA is refused (InputError naming file and key).
 void apply_to_bench(const ClosedLoopScenario& s, CompensationMode mode, hil::BenchSettings& b);
 
-/// Runs the scenario with the given compensation. A pilot_valve scenario runs on the bench's
-/// nodes (hil::simulate_bench with apply_to_bench's settings): the same step code, timing and
-/// bus quantisation as `lash hil run --scenario`, so the figures agree bit for bit. Throws std::invalid_argument on an invalid
-/// configuration (a scenario from load_closed_loop_scenario is valid).
+/// Runs the scenario with the given compensation: one loop for both rigs (each control step the
+/// rig's law, plant and sensor, then the scoring and the trace row; the compensator's state at
+/// the end). A pilot_valve scenario runs on the bench's nodes (hil::BenchSimulation with
+/// apply_to_bench's settings and the ideal schedule): the same step code, timing and bus
+/// quantisation as `lash hil run --scenario`, so the figures agree bit for bit; coupled carts run
+/// in process. Throws std::invalid_argument on an invalid configuration (a scenario from
+/// load_closed_loop_scenario is valid).
 ///
-/// The runner keeps no trace: `row` (when set) gets every sample as it is produced, and the
-/// tracking figures are accumulated on the way (O(1)). Memory: coupled carts O(1) in the
-/// duration; pilot valve: the bench simulation's node logs (hil::simulate_bench, docs/hil.md),
-/// checked against the machine's memory before the run (std::invalid_argument with the figure).
+/// Memory O(1) in the duration for both rigs: `row` (when set) gets every sample as it is
+/// produced, the figures are accumulated on the way (hil::ScenarioScore), a drift ramp is
+/// interpolated at each step (rigs/drift.hpp), and the bench's nodes keep one row each.
 ClosedLoopScenarioResult run_closed_loop_scenario(const ClosedLoopScenario& s, CompensationMode mode,
                                                   const ScenarioRowFn& row = {});
-
-/// Bytes a run of `s` needs that grow with its duration, at least: 0 for the coupled carts; for
-/// the valve the bench simulation's logs, (sizeof master + slave log row + 2 schedule entries)
-/// per sample (a lower bound: measured ~1.1 kB a sample with the vectors' growth, docs/memory.md).
-double scenario_memory_bytes(const ClosedLoopScenario& s);
 
 }  // namespace lash::experiments

@@ -43,6 +43,8 @@
 #include "lash/hil/bench_layout.hpp"
 #include "lash/hil/calibration.hpp"
 #include "lash/hil/e2e.hpp"
+#include "lash/identify/verdict.hpp"
+#include "lash/rigs/drift.hpp"
 #include "lash/rigs/pilot_valve_model.hpp"
 #include "lash/rigs/pilot_valve_rig.hpp"
 #include "lash/signals/signal.hpp"
@@ -136,7 +138,7 @@ class EventLog {
 // `lash hil run|simulate --scenario FILE --compensation MODE` (docs/compensation.md): the slave
 // emulates the E4 valve rig with the scenario's drifts, the master runs the scenario's
 // compensated law. `lash closed-loop --scenario` on a valve scenario runs these very nodes
-// (hil::simulate_bench), so its figures and the emulation's agree bit for bit.
+// (hil::BenchSimulation, schedule.hpp), so its figures and the emulation's agree bit for bit.
 
 /// Under a scenario the valve is driven both ways and its output is a pressure difference
 /// (rigs/pilot_valve_rig.hpp): the master sends a positive current as SolenoidA_Current and a
@@ -149,11 +151,10 @@ inline constexpr double kScenarioPressureZero_kPa = 2000.0;
 struct RigPlant {
   rigs::PilotValveRigParams params;   ///< the rig at t = 0
   std::uint64_t seed = 1;             ///< the rig's noise seed
-  struct Change {
-    std::uint32_t control_step = 0;   ///< first master control step m whose command meets the new rig
-    rigs::PilotValveRigParams params; ///< the rig from then on (valid)
-  };
-  std::vector<Change> drift;          ///< in time order
+  /// Steps and ramps in master control steps (rigs/drift.hpp: a ramp is one segment, interpolated
+  /// at each step): the command of control step m meets the rig of step m. In time order; every
+  /// `before`/`after` valid.
+  std::vector<rigs::DriftSegment<rigs::PilotValveRigParams>> drift;
 };
 
 /// The master's law under a scenario:
@@ -165,14 +166,11 @@ struct CompensatedLaw {
   double feedforward = 0.0;           ///< [mA/kPa]
   double command_min = -2000.0, command_max = 2000.0;  ///< [mA], inside ±the bench's current range
   DeadzoneCompensationConfig compensation;
-  /// compensation.mode = oracle: the plant's true edges as magnitudes [mA] from control step m on
-  /// (in time order; the first at m = 0); the master sets them on the inverse before its step's
-  /// command (Compensator::set_oracle). Empty in the other modes.
-  struct TrueEdges {
-    std::int64_t control_step = 0;
-    double right_mA = 0.0, left_mA = 0.0;
-  };
-  std::vector<TrueEdges> oracle;
+  /// compensation.mode = oracle: the plant the slave runs (its parameters and drifts; the seed is
+  /// not used). Before its step's command the master sets the rig's true edges of control step m
+  /// on the inverse as magnitudes [mA] (Compensator::set_oracle): at the first law step and
+  /// whenever the drifts change them. Unset in the other modes.
+  std::optional<RigPlant> oracle;
 };
 
 /// The compensator's state at the end of a run (trivially copyable: it crosses the hand-over).
@@ -188,6 +186,29 @@ struct CompensationState {
   bool estimator_identified = false;  ///< both sides identified by the estimator's verdict
   char estimator_reason[320] = {};    ///< "right: …; left: …" (truncated to fit)
 };
+
+/// The end state of any adaptive compensator (control/adaptive_compensator.hpp: the master's
+/// DeadzoneCompensator, the carts' BacklashCompensator of the scenario runner): one reading for
+/// every report. right/left are Compensator::in_use() (0 for mode none).
+template <class Comp>
+CompensationState compensation_state(const Comp& comp) noexcept {
+  CompensationState c;
+  c.on = true;
+  c.mode = comp.config().mode;  // as calibrated (docs/xcp.md)
+  const PerSide<double> used = comp.in_use();
+  c.right = used.right;
+  c.left = used.left;
+  c.updates = comp.updates();
+  c.reguesses_right = comp.adapter().reguesses(Side::right);
+  c.reguesses_left = comp.adapter().reguesses(Side::left);
+  c.guess_right = comp.adapter().guess(Side::right);
+  c.guess_left = comp.adapter().guess(Side::left);
+  c.events = comp.events();
+  c.reason = comp.reason();
+  c.estimator_identified = comp.adapter().identified(Side::right) && comp.adapter().identified(Side::left);
+  both_sides_reason(c.estimator_reason, comp.estimator_reason(Side::right), comp.estimator_reason(Side::left));
+  return c;
+}
 
 // ----------------------------------------------------------------------------- slave
 
@@ -255,7 +276,7 @@ class SlaveNode {
   std::uint32_t step_ = 0;
   std::uint64_t sent_ = 0, send_fail_ = 0, dto_replies_ = 0, ignored_ = 0;
   std::optional<rigs::PilotValveRig> rig_;
-  std::size_t next_drift_ = 0;
+  rigs::DriftCursor<rigs::PilotValveRigParams> drift_;
   std::vector<SlaveStepLog> log_;
   std::size_t n_log_ = 0;
 };
@@ -390,7 +411,8 @@ class MasterNode {
   XcpLink* link_ = nullptr;
   double loop_tet_us_ = 0.0, loop_wake_us_ = 0.0, loop_overruns_ = 0.0;  ///< set_loop_figures (console)
   std::size_t next_change_ = 0;
-  std::size_t next_oracle_ = 0;  ///< scenario law, oracle: the next TrueEdges
+  rigs::DriftCursor<rigs::PilotValveRigParams> oracle_;  ///< scenario law, oracle: the plant's drifts
+  bool oracle_started_ = false;  ///< the initial edges were set
   std::vector<CalibrationEvent> cal_events_;
   std::size_t n_cal_events_ = 0;
 };

@@ -108,6 +108,39 @@ struct ScenarioFigures {
 ScenarioFigures scenario_figures(const BenchScenario& s, double dt_s, const std::vector<MasterStepLog>& master,
                                  const std::vector<SlaveStepLog>& slave, const CompensationState& compensation);
 
+/// Tracking over a window, sample by sample in O(1) memory: the arithmetic of tracking() (the
+/// same bits). add() is noexcept and allocation-free.
+class TrackingAccumulator {
+ public:
+  TrackingAccumulator(double dt_s, double t0_s, double t1_s) noexcept : dt_s_(dt_s), w_{t0_s, t1_s, 0, 0.0, 0.0} {}
+  void add(std::size_t m, double r, double y) noexcept;
+  /// The figures so far (t1_s replaced when given: a window that ends with the run).
+  Tracking result() const noexcept;
+
+ private:
+  double dt_s_;
+  Tracking w_;
+  double sum2_ = 0.0;
+};
+
+/// A scenario's figures (ScenarioFigures) accumulated sample by sample: add(m, r(m), y(m)) for
+/// m = 0, 1, … (the window, and before/after the first drift), O(1) memory. scenario_figures()
+/// above is this over the logs; `lash closed-loop --scenario` and `lash hil simulate --scenario`
+/// use it on the rows as the run produces them.
+class ScenarioScore {
+ public:
+  ScenarioScore(const BenchScenario& s, double dt_s) noexcept;
+  void add(std::size_t m, double r, double y) noexcept;
+  ScenarioFigures result(const CompensationState& compensation) const;
+
+ private:
+  std::string file_;
+  CompensationMode mode_;
+  double dt_s_, first_drift_s_;
+  TrackingAccumulator window_, before_, after_;
+  std::size_t samples_ = 0;
+};
+
 /// A node that handed nothing over (it was killed): what the session read back from its CSV log.
 struct LogRecovery {
   std::string file;            ///< the log read

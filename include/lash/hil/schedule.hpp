@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "lash/hil/nodes.hpp"
@@ -84,6 +85,52 @@ FrameSchedule read_schedule(const std::filesystem::path& master_csv, const std::
 /// The control steps of a master.csv as a master log (control_step, measured_kPa, current_mA
 /// filled; the rows before the handshake skipped), to compare with a simulation. Throws InputError.
 std::vector<MasterStepLog> read_master_trace(const std::filesystem::path& master_csv);
+
+class FeedBus;
+class FrameHistory;
+
+/// simulate_bench one control step at a time (the engine of both simulate_bench forms and of
+/// `lash closed-loop --scenario` on the valve): the constructor runs the CCP handshake;
+/// advance() runs the next control step — the slave steps whose frames it needs, then the
+/// master's — handing each row to the sink as its node's step produced it. Memory is O(1) in
+/// the run's length (with a lazy schedule; frames are kept only until the step that uses them).
+/// Not real-time code.
+class BenchSimulation {
+ public:
+  /// Throws std::invalid_argument when the nodes refuse their configurations or the slave did
+  /// not see the CONNECT. `schedule` and `sink` must outlive the simulation.
+  BenchSimulation(const BenchLayout& layout, const MasterConfig& master, const SlaveConfig& slave,
+                  const FrameSchedule& schedule, const SimulationSink& sink);
+  ~BenchSimulation();
+  BenchSimulation(const BenchSimulation&) = delete;
+  BenchSimulation& operator=(const BenchSimulation&) = delete;
+  /// Runs control step m = control_steps(): true when it ran, false at the schedule's end or
+  /// once the master has failed. Throws std::invalid_argument when the schedule is not causal.
+  bool advance();
+  /// Runs the slave steps that pair with the control steps run (s < control_steps()) and are
+  /// still due, then checks the master's end state and returns the events and compensation
+  /// (master and slave empty: the rows went to the sink). Throws std::invalid_argument when the
+  /// master never connected.
+  SimulationResult finish();
+  std::size_t control_steps() const noexcept { return static_cast<std::size_t>(m_); }
+  const MasterNode& master() const noexcept { return master_; }
+
+ private:
+  void master_step(can::Bus& bus, double t);
+  bool slave_ready() const;
+  void slave_step();
+  const BenchLayout& layout_;
+  const FrameSchedule& schedule_;
+  const SimulationSink& sink_;
+  MasterNode master_;
+  SlaveNode slave_;
+  double T_;
+  std::unique_ptr<FeedBus> mb_, sb_;
+  std::unique_ptr<FrameHistory> sensors_, commands_;
+  can::Frame bad_sensor_, bad_command_;
+  std::int64_t m_ = 0, s_ = 0, m_used_ = -1, s_used_ = -1;
+  bool ok_ = true;
+};
 
 /// The closed loop of simulate_bench, with each node fed at each step exactly the frames of
 /// `schedule` (every frame of its sender newer than the last one it used, up to the one it

@@ -2,8 +2,8 @@
 /// @file sim_run.hpp
 /// `lash hil simulate`: the closed loop of the bench through the nodes' step functions
 /// (schedule.hpp: simulate_bench), streamed row by row to a CSV file, so that its memory does not
-/// grow with the duration (apart from a scenario's tracking figures, which keep the run's
-/// reference and pressure; and the log a --schedule replay compares with). Not real-time code.
+/// grow with the duration (a scenario's tracking figures are accumulated row by row; only the
+/// log a --schedule replay compares with is kept). Not real-time code.
 #include <cstddef>
 #include <filesystem>
 #include <optional>
