@@ -222,14 +222,36 @@ SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& m
   return s;
 }
 
+namespace {
+class FrameScheduleSource final : public ScheduleSource {
+ public:
+  explicit FrameScheduleSource(const FrameSchedule& s) : s_(s) {}
+  std::size_t master_steps() const override { return s_.master_steps(); }
+  std::size_t slave_steps() const override { return s_.slave_steps(); }
+  FrameUse master_use(std::size_t m) override { return s_.master_use(m); }
+  FrameUse slave_use(std::size_t s) override { return s_.slave_use(s); }
+
+ private:
+  const FrameSchedule& s_;
+};
+}  // namespace
+
 SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& master_cfg,
                                 const SlaveConfig& slave_cfg, const FrameSchedule& schedule,
+                                const SimulationSink& sink) {
+  FrameScheduleSource src(schedule);
+  return simulate_bench(layout, master_cfg, slave_cfg, src, schedule.calibration, sink);
+}
+
+SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& master_cfg,
+                                const SlaveConfig& slave_cfg, ScheduleSource& schedule,
+                                const std::vector<MasterConfig::CalibrationChange>& calibration,
                                 const SimulationSink& sink) {
   const std::size_t N = schedule.master_steps();
   MasterConfig mc = master_cfg;
   mc.log_capacity = 1;  // one row, handed to the sink after each step
   mc.bus_log_capacity = 1;
-  if (!schedule.calibration.empty()) mc.calibration_schedule = schedule.calibration;
+  if (!calibration.empty()) mc.calibration_schedule = calibration;
   SlaveConfig sc = slave_cfg;
   sc.log_capacity = 1;
   MasterNode master(layout, mc);

@@ -55,6 +55,18 @@ struct FrameSchedule {
   }
 };
 
+/// A schedule given step by step, for a replay whose schedule is not kept in memory (the session
+/// reads its nodes' logs as the replay goes, report_logs.hpp). simulate_bench asks for master
+/// steps m = 0, 1, … and slave steps s = 0, 1, …, each maybe more than once, never backwards.
+class ScheduleSource {
+ public:
+  virtual ~ScheduleSource() = default;
+  virtual std::size_t master_steps() const = 0;
+  virtual std::size_t slave_steps() const = 0;
+  virtual FrameUse master_use(std::size_t m) = 0;
+  virtual FrameUse slave_use(std::size_t s) = 0;
+};
+
 /// What simulate_bench's streaming form hands on, row by row, as the nodes' steps produce them.
 struct SimulationSink {
   std::function<void(const MasterStepLog&)> master;  ///< every master step (the connecting step included)
@@ -99,5 +111,11 @@ SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& m
 /// The rows are those of the form above, bit for bit, in the same order per node.
 SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& master, const SlaveConfig& slave,
                                 const FrameSchedule& schedule, const SimulationSink& sink);
+/// The same with the schedule read step by step from `schedule` and the master's calibration
+/// changes given apart (FrameSchedule::calibration).
+SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& master, const SlaveConfig& slave,
+                                ScheduleSource& schedule,
+                                const std::vector<MasterConfig::CalibrationChange>& calibration,
+                                const SimulationSink& sink);
 
 }  // namespace lash::hil
