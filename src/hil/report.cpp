@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 
 #include "json_parts.hpp"
@@ -187,6 +188,55 @@ ScenarioFigures scenario_figures(const BenchScenario& s, double dt_s, const std:
     const double before_end = static_cast<double>(std::llround(s.first_drift_s / dt_s) - 1) * dt_s;
     f.before_drift = tracking(ref, y, dt_s, 0.0, before_end);
     if (s.first_drift_s < end) f.after_drift = tracking(ref, y, dt_s, s.first_drift_s, end);
+  }
+  f.compensation = compensation;
+  return f;
+}
+
+void ScenarioFiguresStream::Window::add(double t, double e) {
+  if (t < w.t0_s - 1e-12 || t > w.t1_s + 1e-12) return;
+  sum2 += e * e;
+  w.max_abs_error = std::max(w.max_abs_error, std::fabs(e));
+  ++w.samples;
+}
+
+Tracking ScenarioFiguresStream::Window::result(double t1_s) const {
+  Tracking r = w;
+  r.t1_s = t1_s;
+  r.rms_error = r.samples ? std::sqrt(sum2 / static_cast<double>(r.samples)) : std::nan("");
+  return r;
+}
+
+ScenarioFiguresStream::ScenarioFiguresStream(const BenchScenario& s, double dt_s) : s_(s), dt_s_(dt_s) {
+  window_.w.t0_s = s.score_t0_s;
+  window_.w.t1_s = s.score_t1_s;
+  if (s.first_drift_s >= 0) {
+    before_.w.t1_s = static_cast<double>(std::llround(s.first_drift_s / dt_s) - 1) * dt_s;
+    after_.w.t0_s = s.first_drift_s;
+    // Every sample given lies before the end of the pairs (t = m·dt_s < n·dt_s).
+    after_.w.t1_s = std::numeric_limits<double>::infinity();
+  }
+}
+
+void ScenarioFiguresStream::add(double r, double y) {
+  const double t = static_cast<double>(n_++) * dt_s_;
+  const double e = r - y;
+  window_.add(t, e);
+  if (s_.first_drift_s >= 0) {
+    before_.add(t, e);
+    after_.add(t, e);
+  }
+}
+
+ScenarioFigures ScenarioFiguresStream::result(const CompensationState& compensation) const {
+  ScenarioFigures f;
+  f.file = s_.file;
+  f.mode = s_.mode;
+  f.window = window_.result(s_.score_t1_s);
+  const double end = static_cast<double>(n_) * dt_s_;
+  if (s_.first_drift_s >= 0) {
+    f.before_drift = before_.result(before_.w.t1_s);
+    if (s_.first_drift_s < end) f.after_drift = after_.result(end);
   }
   f.compensation = compensation;
   return f;

@@ -188,34 +188,6 @@ class LogSchedule final : public ScheduleSource {
   std::size_t nm_, ns_, im_ = 0, is_ = 0;
 };
 
-/// tracking() over samples given one at a time (sample m at t = m·dt_s).
-class TrackingStream {
- public:
-  TrackingStream(double dt_s, double t0_s, double t1_s) : dt_s_(dt_s) {
-    w_.t0_s = t0_s;
-    w_.t1_s = t1_s;
-  }
-  void add(std::size_t m, double r, double y) {
-    const double t = static_cast<double>(m) * dt_s_;
-    if (t < w_.t0_s - 1e-12 || t > w_.t1_s + 1e-12) return;
-    const double e = r - y;
-    sum2_ += e * e;
-    w_.max_abs_error = std::max(w_.max_abs_error, std::fabs(e));
-    ++w_.samples;
-  }
-  Tracking result(double t1_s) const {
-    Tracking w = w_;
-    w.t1_s = t1_s;
-    w.rms_error = w.samples ? std::sqrt(sum2_ / static_cast<double>(w.samples)) : std::nan("");
-    return w;
-  }
-
- private:
-  double dt_s_;
-  Tracking w_;
-  double sum2_ = 0.0;
-};
-
 /// What one pass over the master's control rows and the slave's rows side by side gives (row i
 /// of each: control step i, slave step i): off_schedule_steps(), step_response(), the scenario's
 /// tracking figures, and the control steps the slave's schedule can replay.
@@ -242,15 +214,8 @@ PairedFigures paired_pass(const std::filesystem::path* master_csv, const std::fi
   StepResponseStream step(dt_s, true);
   std::size_t n_ref = 0, n_slave = 0;
   bool replay_cut = false;
-  std::optional<TrackingStream> window, before, after;
-  if (scenario) {
-    window.emplace(dt_s, scenario->score_t0_s, scenario->score_t1_s);
-    if (scenario->first_drift_s >= 0) {
-      const double before_end = static_cast<double>(std::llround(scenario->first_drift_s / dt_s) - 1) * dt_s;
-      before.emplace(dt_s, 0.0, before_end);
-      after.emplace(dt_s, scenario->first_drift_s, std::numeric_limits<double>::infinity());
-    }
-  }
+  std::optional<ScenarioFiguresStream> figures;
+  if (scenario) figures.emplace(*scenario, dt_s);
   for (;;) {
     const bool have_m = m && !m->done(), have_s = s && !s->done();
     if (!have_m && !have_s) break;
@@ -270,14 +235,7 @@ PairedFigures paired_pass(const std::filesystem::path* master_csv, const std::fi
     }
     if (have_m && with_step)  // the step is found on the reference; its window needs the slave's rows
       step.add(m->row().reference_kPa, have_s ? s->row().pressure_kPa : 0.0, have_s ? s->row().measured_kPa : 0.0);
-    if (have_m && have_s && scenario) {
-      const std::size_t k = n_ref;  // = n_slave
-      window->add(k, m->row().reference_kPa, s->row().pressure_kPa);
-      if (before) {
-        before->add(k, m->row().reference_kPa, s->row().pressure_kPa);
-        after->add(k, m->row().reference_kPa, s->row().pressure_kPa);
-      }
-    }
+    if (have_m && have_s && figures) figures->add(m->row().reference_kPa, s->row().pressure_kPa);
     if (have_m) {
       ++n_ref;
       m->advance();
@@ -297,19 +255,7 @@ PairedFigures paired_pass(const std::filesystem::path* master_csv, const std::fi
     out.step = step.result();
     if (out.step && out.step->window.end > n_slave) out.step.reset();  // the slave's log ends inside the window
   }
-  if (scenario) {
-    ScenarioFigures f;
-    f.file = scenario->file;
-    f.mode = scenario->mode;
-    f.window = window->result(scenario->score_t1_s);
-    const double end = static_cast<double>(std::min(n_ref, n_slave)) * dt_s;
-    if (before) {
-      const double before_end = static_cast<double>(std::llround(scenario->first_drift_s / dt_s) - 1) * dt_s;
-      f.before_drift = before->result(before_end);
-      if (scenario->first_drift_s < end) f.after_drift = after->result(end);
-    }
-    out.scenario = f;
-  }
+  if (figures) out.scenario = figures->result(CompensationState{});
   return out;
 }
 

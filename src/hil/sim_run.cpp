@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <deque>
+#include <optional>
 
 #include "lash/io/atomic_file.hpp"
 #include "lash/io/csv.hpp"
@@ -16,8 +17,8 @@ SimulationFileRun simulate_to_csv(const BenchLayout& layout, const MasterConfig&
   f.stream() << "control_step,t_s,reference_kPa,measured_kPa,current_mA,pressure_kPa\n";
   StepResponseStream step(dt_s);
   SimulationDiff diff;
-  std::vector<MasterStepLog> scenario_master;  // scenario figures only
-  std::vector<SlaveStepLog> scenario_slave;
+  std::optional<ScenarioFiguresStream> figures;  // scenario runs
+  if (scenario) figures.emplace(*scenario, dt_s);
   // Control step m pairs with slave step m; either may come first.
   std::deque<MasterStepLog> masters;
   std::deque<SlaveStepLog> slaves;
@@ -37,7 +38,10 @@ SimulationFileRun simulate_to_csv(const BenchLayout& layout, const MasterConfig&
       }
       line += '\n';
       f.stream() << line;
-      if (!scenario) step.add(ml.reference_kPa, sl.pressure_kPa);
+      if (figures)
+        figures->add(ml.reference_kPa, sl.pressure_kPa);
+      else
+        step.add(ml.reference_kPa, sl.pressure_kPa);
       ++run.rows;
       masters.pop_front();
       slaves.pop_front();
@@ -45,7 +49,6 @@ SimulationFileRun simulate_to_csv(const BenchLayout& layout, const MasterConfig&
   };
   SimulationSink sink;
   sink.master = [&](const MasterStepLog& l) {
-    if (scenario) scenario_master.push_back(l);
     if (l.control_step < 0) return;
     if (compare_with) {  // compare_with_simulation(), one simulated row at a time
       const auto m = static_cast<std::size_t>(l.control_step);
@@ -63,7 +66,6 @@ SimulationFileRun simulate_to_csv(const BenchLayout& layout, const MasterConfig&
     emit();
   };
   sink.slave = [&](const SlaveStepLog& l) {
-    if (scenario) scenario_slave.push_back(l);
     slaves.push_back(l);
     emit();
   };
@@ -72,7 +74,7 @@ SimulationFileRun simulate_to_csv(const BenchLayout& layout, const MasterConfig&
   run.compensation = r.compensation;
   if (compare_with) run.vs_log = diff;
   if (scenario) {
-    run.scenario = scenario_figures(*scenario, dt_s, scenario_master, scenario_slave, r.compensation);
+    run.scenario = figures->result(r.compensation);
   } else {
     run.step = step.result();
   }

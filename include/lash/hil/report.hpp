@@ -108,6 +108,27 @@ struct ScenarioFigures {
 ScenarioFigures scenario_figures(const BenchScenario& s, double dt_s, const std::vector<MasterStepLog>& master,
                                  const std::vector<SlaveStepLog>& slave, const CompensationState& compensation);
 
+/// scenario_figures() over the pairs given one at a time (control step m's reference and slave
+/// step m's plant pressure, m = 0, 1, …), in constant memory: the same figures, bit for bit.
+class ScenarioFiguresStream {
+ public:
+  ScenarioFiguresStream(const BenchScenario& s, double dt_s);
+  void add(double reference_kPa, double pressure_kPa);
+  ScenarioFigures result(const CompensationState& compensation) const;
+
+ private:
+  struct Window {
+    Tracking w;
+    double sum2 = 0.0;
+    void add(double t, double e);
+    Tracking result(double t1_s) const;
+  };
+  const BenchScenario& s_;
+  double dt_s_;
+  std::size_t n_ = 0;
+  Window window_, before_, after_;
+};
+
 /// A node that handed nothing over (it was killed): what the session read back from its CSV log.
 struct LogRecovery {
   std::string file;            ///< the log read
