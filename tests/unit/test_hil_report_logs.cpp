@@ -17,6 +17,8 @@
 #include "lash/hil/report.hpp"
 #include "lash/hil/report_logs.hpp"
 #include "lash/hil/schedule.hpp"
+#include "lash/hil/sim_run.hpp"
+#include "lash/io/error.hpp"
 #include "recorded_dto.hpp"
 
 using namespace lash;
@@ -240,5 +242,77 @@ TEST(HilReportLogs, ScenarioFiguresAndKilledNodes) {
     EXPECT_EQ(run_report_json(a), run_report_json(b));
     EXPECT_FALSE(b.step.has_value());
   }
+  std::filesystem::remove_all(d);
+}
+
+// `lash hil simulate --schedule` in constant memory (ScheduleFiles, TraceCompare) against the
+// schedule and trace read whole (read_schedule, read_master_trace): the same CSV, byte for byte,
+// and the same differences from the log; the same errors for a bad log.
+TEST(HilReportLogs, ScheduleFilesEqualTheScheduleReadWhole) {
+  const auto d = temp_dir();
+  Logged r = logged_run(1200);
+  r.slave.log.resize(700);  // a slave killed first: the replay stops where its schedule does
+  r.slave.loop.records.resize(700);
+  write_logs(d, r);
+  const BenchLayout L;
+  FrameSchedule fs = read_schedule(d / "master.csv", d / "slave.csv");
+  const std::size_t kept = replayable_control_steps(fs);
+  fs.master.resize(kept);
+  const std::vector<MasterStepLog> trace = read_master_trace(d / "master.csv");
+  const SimulationFileRun a = simulate_to_csv(L, master_cfg(), slave_cfg(), fs, kT, d / "a.csv", nullptr, &trace);
+
+  ScheduleFiles sf(d / "master.csv", d / "slave.csv");
+  EXPECT_EQ(sf.logged_control_steps(), 1200u);
+  EXPECT_EQ(sf.slave_steps(), 700u);
+  EXPECT_EQ(sf.replayable(), 700u);  // control step 700 uses slave step 700's frame
+  EXPECT_EQ(kept, 700u);
+  EXPECT_EQ(sf.calibration().size(), fs.calibration.size());
+  sf.limit(sf.replayable());
+  const SimulationFileRun b = simulate_to_csv(L, master_cfg(), slave_cfg(), sf, kT, d / "b.csv", nullptr, d / "master.csv");
+  auto text = [](const std::filesystem::path& p) {
+    std::ifstream in(p);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  EXPECT_EQ(a.rows, 700u);
+  EXPECT_EQ(b.rows, a.rows);
+  EXPECT_EQ(text(d / "a.csv"), text(d / "b.csv"));
+  ASSERT_TRUE(a.vs_log && b.vs_log);
+  EXPECT_EQ(b.vs_log->compared, 700u);
+  EXPECT_EQ(b.vs_log->compared, a.vs_log->compared);
+  EXPECT_EQ(b.vs_log->max_abs_diff_kPa, a.vs_log->max_abs_diff_kPa);
+  EXPECT_EQ(b.vs_log->max_abs_diff_mA, a.vs_log->max_abs_diff_mA);
+  EXPECT_EQ(b.vs_log->first_diff_step, a.vs_log->first_diff_step);
+  EXPECT_EQ(*b.vs_log->first_diff_step, 300);  // the altered row: the replay equals the log before it
+  EXPECT_DOUBLE_EQ(b.vs_log->max_abs_diff_kPa, 0.25);
+
+  // A bad value: the same file, line and column either way.
+  {
+    std::string s = text(d / "slave.csv");
+    const std::size_t line3 = s.find('\n', s.find('\n') + 1) + 1;  // the second row
+    std::string row = s.substr(line3, s.find('\n', line3) - line3);
+    std::size_t c = 0;
+    for (int k = 0; k < 4; ++k) c = row.find(',', c) + 1;  // command_fresh is the 5th column
+    row.replace(c, row.find(',', c) - c, "2");
+    s.replace(line3, s.find('\n', line3) - line3, row);
+    std::ofstream(d / "bad.csv") << s;
+  }
+  std::string e1, e2;
+  int l1 = 0, l2 = 0;
+  try {
+    (void)read_schedule(d / "master.csv", d / "bad.csv");
+  } catch (const InputError& e) {
+    e1 = e.field();
+    l1 = e.line();
+  }
+  try {
+    ScheduleFiles bad(d / "master.csv", d / "bad.csv");
+  } catch (const InputError& e) {
+    e2 = e.field();
+    l2 = e.line();
+  }
+  EXPECT_EQ(e1, "command_fresh");
+  EXPECT_EQ(l1, 3);
+  EXPECT_EQ(e2, e1);
+  EXPECT_EQ(l2, l1);
   std::filesystem::remove_all(d);
 }

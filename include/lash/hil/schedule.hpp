@@ -17,9 +17,12 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
+#include <algorithm>
 #include <vector>
 
 #include "lash/hil/nodes.hpp"
+#include "lash/hil/report.hpp"
 #include "lash/hil/simulate.hpp"
 
 namespace lash::hil {
@@ -92,6 +95,54 @@ std::size_t replayable_control_steps(const FrameSchedule& s) noexcept;
 /// dropped) and slave.csv (command_counter, command_fresh, dropped). Throws InputError naming
 /// the file, line and column of a missing column or a value that is not a step number.
 FrameSchedule read_schedule(const std::filesystem::path& master_csv, const std::filesystem::path& slave_csv);
+
+/// read_schedule() in constant memory: the logs are checked in a first pass (the errors of
+/// read_schedule, naming file, line and column; a last line cut short, of a killed node, is
+/// left out), then read again step by step as simulate_bench asks for them.
+class ScheduleFiles final : public ScheduleSource {
+ public:
+  ScheduleFiles(const std::filesystem::path& master_csv, const std::filesystem::path& slave_csv);
+  ~ScheduleFiles() override;
+  ScheduleFiles(const ScheduleFiles&) = delete;
+  ScheduleFiles& operator=(const ScheduleFiles&) = delete;
+  /// The control steps master.csv holds.
+  std::size_t logged_control_steps() const noexcept { return logged_; }
+  /// replayable_control_steps() of the schedule.
+  std::size_t replayable() const noexcept { return replayable_; }
+  /// Replays only the first `control_steps` (at most the logged ones).
+  void limit(std::size_t control_steps) noexcept { steps_ = std::min(control_steps, logged_); }
+  /// FrameSchedule::calibration of the schedule.
+  const std::vector<MasterConfig::CalibrationChange>& calibration() const noexcept { return calibration_; }
+
+  std::size_t master_steps() const override { return steps_; }
+  std::size_t slave_steps() const override { return slave_steps_; }
+  FrameUse master_use(std::size_t m) override;
+  FrameUse slave_use(std::size_t s) override;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  std::size_t logged_ = 0, replayable_ = 0, steps_ = 0, slave_steps_ = 0;
+  std::vector<MasterConfig::CalibrationChange> calibration_;
+};
+
+/// compare_with_simulation() of a master.csv's control rows (read_master_trace: control_step,
+/// measured_kPa, current_mA) with simulated master rows given one at a time in ascending control
+/// step, reading the log as they come (constant memory). Throws InputError as read_master_trace.
+class TraceCompare {
+ public:
+  explicit TraceCompare(const std::filesystem::path& master_csv);
+  ~TraceCompare();
+  TraceCompare(const TraceCompare&) = delete;
+  TraceCompare& operator=(const TraceCompare&) = delete;
+  void add(const MasterStepLog& simulated);
+  const SimulationDiff& result() const noexcept { return d_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  SimulationDiff d_;
+};
 
 /// The control steps of a master.csv as a master log (control_step, measured_kPa, current_mA
 /// filled; the rows before the handshake skipped), to compare with a simulation. Throws InputError.
