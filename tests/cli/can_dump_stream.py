@@ -14,6 +14,7 @@ private network namespace; the frames go over UDP multicast on its loopback only
 import glob
 import os
 import re
+import shutil
 import signal
 import subprocess
 import sys
@@ -144,4 +145,5 @@ for n in (20_000, 200_000):
         fail("too few frames received")
 if peaks[200_000] > peaks[20_000] + 4.0:
     fail(f"peak RSS grows with the frames: {peaks}")
+shutil.rmtree(tmp)
 print("ok")
