@@ -9,12 +9,15 @@
 #include <cstring>
 #include <map>
 #include <memory>
+#include <optional>
 
 #include <fmt/core.h>
 
 #include "cmd_can.hpp"
 #include "lash/can/bus.hpp"
 #include "lash/can/log.hpp"
+#include "lash/can/log_reader.hpp"
+#include "lash/io/atomic_file.hpp"
 #include "lash/rt/periodic.hpp"
 
 namespace lash::cli {
@@ -81,13 +84,74 @@ can::Filter parse_filter(const std::string& text) {
   return f;
 }
 
+/// Where `can dump --log FILE` puts the frames while it runs: candump -L lines in a temporary
+/// file next to FILE (AtomicFile: `FILE.tmp.<random>`), flushed at least once a second, so that
+/// a killed dump leaves every frame but those of its last second there. A candump FILE is that
+/// file renamed at the end; a relative format (.asc, .trc, .blf: they need the earliest time up
+/// front) is converted from it at the end (times kept to the nanosecond) and it is removed.
+class DumpLog {
+ public:
+  explicit DumpLog(const std::string& target)
+      : target_(target), format_(can::log_format_of(target)),
+        spool_(format_ == can::LogFormat::candump || !is_stream_output(target)
+                   ? std::filesystem::path(target)
+                   : std::filesystem::temp_directory_path() / "lash-can-dump.log") {
+    if (!spool_.direct())
+      fmt::print(stderr, "lash can dump: frames go to {} as they arrive (flushed every second); {} {} at the end\n",
+                 spool_.temp_path().string(), format_ == can::LogFormat::candump ? "renamed to" : "converted to", target);
+  }
+  void add(const can::Frame& f, const std::string& iface, const std::string& line) {
+    if (format_ == can::LogFormat::candump)
+      spool_.stream() << line << '\n';
+    else
+      spool_.stream() << can::format_log_line(f, iface, 9) << '\n';
+    const std::int64_t now = rt::monotonic_ns();
+    if (now - last_flush_ns_ >= 500'000'000) flush(now);
+  }
+  /// No frame this wait: what is buffered still reaches the disk within the second.
+  void add_nothing() {
+    const std::int64_t now = rt::monotonic_ns();
+    if (now - last_flush_ns_ >= 500'000'000) flush(now);
+  }
+  void flush(std::int64_t now) {
+    spool_.stream().flush();
+    last_flush_ns_ = now;
+  }
+  void finish() {
+    flush(rt::monotonic_ns());
+    if (format_ == can::LogFormat::candump) {
+      spool_.commit();
+      return;
+    }
+    can::LogTimes times;  // a first pass for the earliest time, a second one to write
+    {
+      can::LogReader r(spool_.temp_path());
+      for (can::LogEntry e; r.next(e);) times.add(e.frame.timestamp_s);
+    }
+    AtomicFile out(target_);
+    can::LogWriter w(out.stream(), format_, times, target_);
+    can::LogReader r(spool_.temp_path());
+    for (can::LogEntry e; r.next(e);) w.write(e);
+    w.finish();
+    out.commit();
+  }  // the spool is removed with spool_ (never committed)
+
+ private:
+  std::string target_;
+  can::LogFormat format_;
+  AtomicFile spool_;
+  std::int64_t last_flush_ns_ = rt::monotonic_ns();
+};
+
 int run_dump(const DumpOptions& o) {
   std::vector<can::Filter> filters;
   for (const auto& t : o.filters) filters.push_back(parse_filter(t));
+  if (!o.log.empty()) check_output_path(o.log, "--log");
   auto bus = can::open_bus(o.bus);
   if (!filters.empty()) bus->set_filters(filters);
   const std::string iface = o.iface.empty() ? default_iface(o.bus) : o.iface;
-  std::vector<can::LogEntry> logged;
+  std::optional<DumpLog> log;
+  if (!o.log.empty()) log.emplace(o.log);
   install_stop_handler();
   long n = 0;
   timespec start{};
@@ -103,17 +167,20 @@ int run_dump(const DumpOptions& o) {
       if (left < 0.1) chunk = std::chrono::milliseconds(static_cast<long>(left * 1000) + 1);
     }
     auto f = bus->receive(chunk);
-    if (!f) continue;
+    if (!f) {
+      if (log) log->add_nothing();
+      continue;
+    }
     const std::string line = can::format_log_line(*f, iface);
     if (!o.quiet) {
       std::fputs(line.c_str(), stdout);
       std::fputc('\n', stdout);
       std::fflush(stdout);
     }
-    if (!o.log.empty()) logged.push_back({*f, iface});
+    if (log) log->add(*f, iface, line);
     ++n;
   }
-  if (!o.log.empty()) can::write_log(o.log, logged);
+  if (log) log->finish();
   const auto st = bus->stats();
   fmt::print(stderr, "lash can dump: {} frames ({} filtered, {} dropped)\n", n, st.filtered, st.dropped);
   if (o.count >= 0 && n < o.count) return kExitFailed;

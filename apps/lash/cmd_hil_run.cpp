@@ -197,19 +197,18 @@ int run_simulate(const SimulateOptions& o) {
     const std::filesystem::path mpath(o.schedule);
     const std::filesystem::path spath =
         o.slave_schedule.empty() ? mpath.parent_path() / "slave.csv" : std::filesystem::path(o.slave_schedule);
-    hil::FrameSchedule fs = hil::read_schedule(mpath, spath);
-    const std::size_t logged = fs.master.size();
-    const std::size_t kept = hil::replayable_control_steps(fs);
+    hil::ScheduleFiles fs(mpath, spath);  // read as the replay goes: memory independent of the log's length
+    const std::size_t logged = fs.logged_control_steps();
+    const std::size_t kept = fs.replayable();
     if (kept < logged) {  // a slave killed before the master: its log ends first
       fmt::print("schedule of {}: the slave's log ({} steps) ends before the master's; replaying the first {} of {} "
                  "control steps\n",
-                 o.schedule, fs.slave.size(), kept, logged);
-      fs.master.resize(kept);
+                 o.schedule, fs.slave_steps(), kept, logged);
+      fs.limit(kept);
     }
-    const std::vector<hil::MasterStepLog> trace = hil::read_master_trace(mpath);
-    run = hil::simulate_to_csv(L, mc, sc, fs, s.step_s, o.out, s.scenario ? &*s.scenario : nullptr, &trace);
+    run = hil::simulate_to_csv(L, mc, sc, fs, s.step_s, o.out, s.scenario ? &*s.scenario : nullptr, mpath);
     fmt::print("schedule of {} ({} control steps): max |log - simulation| {} kPa, {} mA over {} steps\n", o.schedule,
-               fs.master.size(), format_double(run.vs_log->max_abs_diff_kPa),
+               fs.master_steps(), format_double(run.vs_log->max_abs_diff_kPa),
                format_double(run.vs_log->max_abs_diff_mA), run.vs_log->compared);
   }
   fmt::print(stderr, "lash hil simulate: {} steps at {} ms -> {}\n", run.rows, format_double(s.step_s * 1e3), o.out);

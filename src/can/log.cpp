@@ -368,18 +368,25 @@ std::optional<LogEntry> parse_log_line(std::string_view line, std::string& error
 }
 
 std::string format_log_line(const Frame& frame, std::string_view interface) {
+  return format_log_line(frame, interface, 6);
+}
+
+std::string format_log_line(const Frame& frame, std::string_view interface, unsigned fraction_digits) {
+  const bool ns = fraction_digits >= 9;
+  const double scale = ns ? 1e9 : 1e6;
+  const auto one = static_cast<std::uint64_t>(scale);
   // A time candump cannot hold (writable_times) is written as 0: write_log refuses such frames
   // before it gets here; a live dump's times come from the clock.
   double t = frame.timestamp_s;
   const TimeSpan span = writable_times(LogFormat::candump);
   if (!(t >= span.min_abs_s && t < span.max_abs_s)) t = 0;
   auto sec = static_cast<std::uint64_t>(std::floor(t));
-  auto us = static_cast<std::uint64_t>(std::llround((t - static_cast<double>(sec)) * 1e6));
-  if (us >= 1000000) {
+  auto frac = static_cast<std::uint64_t>(std::llround((t - static_cast<double>(sec)) * scale));
+  if (frac >= one) {
     sec += 1;
-    us -= 1000000;
+    frac -= one;
   }
-  return fmt::format("({}.{:06d}) {} {}", sec, us, interface.empty() ? std::string_view("can0") : interface,
+  return fmt::format("({}.{:0{}d}) {} {}", sec, frac, ns ? 9 : 6, interface.empty() ? std::string_view("can0") : interface,
                      format_frame_text(frame));
 }
 

@@ -4,90 +4,19 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "lash/hil/handover.hpp"
 #include "lash/io/error.hpp"
+#include "csv_lines.hpp"
 
 namespace lash::hil {
 
+using detail::LogLines;
+
 namespace {
-
-/// A CSV log with a known header, read line by line; a last line without its newline (a node
-/// killed mid-write) is dropped and counted.
-class LogLines {
- public:
-  LogLines(const std::filesystem::path& path, const std::vector<std::string>& columns) : path_(path.string()), in_(path) {
-    if (!in_) throw InputError(path_, 0, "", "cannot open the log");
-    std::string header;
-    if (!std::getline(in_, header) || in_.eof()) {
-      header_ok_ = false;  // empty, or killed before the header was out: no rows
-      return;
-    }
-    std::vector<std::string> names = split_names(header);
-    for (const auto& c : columns) {
-      std::size_t i = 0;
-      while (i < names.size() && names[i] != c) ++i;
-      if (i == names.size()) throw InputError(path_, 1, c, "column missing from the log's header");
-      index_.push_back(i);
-    }
-    width_ = names.size();
-  }
-  /// The next whole row's values of the asked columns; false at the end.
-  bool next(std::vector<double>& out, LogReadBack& rb) {
-    if (!header_ok_) return false;
-    std::string line;
-    while (std::getline(in_, line)) {
-      ++line_no_;
-      if (in_.eof()) {  // no newline after it: cut short
-        if (!line.empty()) ++rb.cut_lines;
-        return false;
-      }
-      if (line.empty()) continue;
-      cells_.clear();
-      const char* p = line.c_str();
-      for (;;) {
-        char* end = nullptr;
-        errno = 0;
-        const double v = std::strtod(p, &end);
-        if (end == p || (*end != ',' && *end != '\0'))
-          throw InputError(path_, line_no_, column_name(cells_.size()), "not a number");
-        cells_.push_back(v);
-        if (*end == '\0') break;
-        p = end + 1;
-      }
-      if (cells_.size() != width_)
-        throw InputError(path_, line_no_, "", std::to_string(cells_.size()) + " values, the header has " +
-                                                  std::to_string(width_));
-      out.clear();
-      for (std::size_t i : index_) out.push_back(cells_[i]);
-      ++rb.rows;
-      return true;
-    }
-    return false;
-  }
-
- private:
-  static std::vector<std::string> split_names(const std::string& h) {
-    std::vector<std::string> v(1);
-    for (char c : h) {
-      if (c == ',')
-        v.emplace_back();
-      else if (c != '\r')
-        v.back() += c;
-    }
-    return v;
-  }
-  std::string column_name(std::size_t i) const { return "column " + std::to_string(i + 1); }
-  std::string path_;
-  std::ifstream in_;
-  bool header_ok_ = true;
-  std::vector<std::size_t> index_;
-  std::size_t width_ = 0;
-  int line_no_ = 1;
-  std::vector<double> cells_;
-};
 
 std::int64_t ns(double us) { return std::llround(us * 1e3); }
 
@@ -97,62 +26,107 @@ rt::StepRecord record_of(double t_s, double tet_us, double io_us, double wake_us
 
 }  // namespace
 
-LogReadBack read_master_log(const std::filesystem::path& path, std::vector<MasterStepLog>& log,
-                            std::vector<rt::StepRecord>& records) {
+// ----------------------------------------------------------------------------- row by row
+
+namespace {
+std::vector<std::string> master_columns() {
   std::vector<std::string> cols{"step",       "t_s",           "state",         "control_step",    "reference_kPa",
                                 "measured_kPa", "sensor_counter", "sensor_fresh", "sensor_seq",     "dropped",
                                 "current_mA", "integrator_mA", "command_counter", "tet_us",         "io_us",
                                 "wake_latency_us"};
-  const auto fields = calibration_fields();
-  for (const auto& f : fields) cols.emplace_back(f.name);
-  LogLines in(path, cols);
-  LogReadBack rb;
+  for (const auto& f : calibration_fields()) cols.emplace_back(f.name);
+  return cols;
+}
+const std::vector<std::string> kSlaveColumns{"step",         "t_s",          "state",        "command_counter",
+                                             "command_fresh", "dropped",     "current_mA",   "pressure_kPa",
+                                             "measured_kPa", "pilot_raw",    "tet_us",       "io_us",
+                                             "wake_latency_us"};
+}  // namespace
+
+struct MasterLogReader::Impl {
+  explicit Impl(const std::filesystem::path& p) : in(p, master_columns()) {}
+  LogLines in;
   std::vector<double> v;
-  while (in.next(v, rb)) {
-    MasterStepLog l;
-    l.step = static_cast<std::uint32_t>(v[0]);
-    l.state = static_cast<NodeState>(static_cast<int>(v[2]));
-    l.control_step = static_cast<std::int64_t>(v[3]);
-    l.reference_kPa = v[4];
-    l.measured_kPa = v[5];
-    l.sensor_counter = static_cast<std::uint16_t>(v[6]);
-    l.sensor_fresh = v[7] != 0.0;
-    l.sensor_seq = static_cast<std::int64_t>(v[8]);
-    l.dropped = static_cast<std::uint16_t>(v[9]);
-    l.current_mA = v[10];
-    l.integrator_mA = v[11];
-    l.command_sent = v[12] >= 0.0;
-    l.command_counter = l.command_sent ? static_cast<std::uint16_t>(v[12]) : 0;
-    for (std::size_t j = 0; j < fields.size(); ++j) l.calibration.*fields[j].member = v[16 + j];
+};
+
+MasterLogReader::MasterLogReader(const std::filesystem::path& path) : impl_(std::make_unique<Impl>(path)) {}
+MasterLogReader::~MasterLogReader() = default;
+
+bool MasterLogReader::next(MasterStepLog& l, rt::StepRecord& record) {
+  if (!impl_->in.next(impl_->v, rb_)) return false;
+  const std::vector<double>& v = impl_->v;
+  static const auto fields = calibration_fields();
+  l = MasterStepLog{};
+  l.step = static_cast<std::uint32_t>(v[0]);
+  l.state = static_cast<NodeState>(static_cast<int>(v[2]));
+  l.control_step = static_cast<std::int64_t>(v[3]);
+  l.reference_kPa = v[4];
+  l.measured_kPa = v[5];
+  l.sensor_counter = static_cast<std::uint16_t>(v[6]);
+  l.sensor_fresh = v[7] != 0.0;
+  l.sensor_seq = static_cast<std::int64_t>(v[8]);
+  l.dropped = static_cast<std::uint16_t>(v[9]);
+  l.current_mA = v[10];
+  l.integrator_mA = v[11];
+  l.command_sent = v[12] >= 0.0;
+  l.command_counter = l.command_sent ? static_cast<std::uint16_t>(v[12]) : 0;
+  for (std::size_t j = 0; j < fields.size(); ++j) l.calibration.*fields[j].member = v[16 + j];
+  record = record_of(v[1], v[13], v[14], v[15]);
+  rb_.last_t_s = v[1];
+  return true;
+}
+
+struct SlaveLogReader::Impl {
+  explicit Impl(const std::filesystem::path& p) : in(p, kSlaveColumns) {}
+  LogLines in;
+  std::vector<double> v;
+};
+
+SlaveLogReader::SlaveLogReader(const std::filesystem::path& path) : impl_(std::make_unique<Impl>(path)) {}
+SlaveLogReader::~SlaveLogReader() = default;
+
+bool SlaveLogReader::next(SlaveStepLog& l, rt::StepRecord& record) {
+  if (!impl_->in.next(impl_->v, rb_)) return false;
+  const std::vector<double>& v = impl_->v;
+  l = SlaveStepLog{};
+  l.step = static_cast<std::uint32_t>(v[0]);
+  l.state = static_cast<NodeState>(static_cast<int>(v[2]));
+  l.command_counter = static_cast<std::uint64_t>(v[3]);
+  l.command_fresh = v[4] != 0.0;
+  l.dropped = static_cast<std::uint16_t>(v[5]);
+  l.current_mA = v[6];
+  l.pressure_kPa = v[7];
+  l.measured_kPa = v[8];
+  l.pilot_raw = static_cast<std::uint16_t>(v[9]);
+  record = record_of(v[1], v[10], v[11], v[12]);
+  rb_.last_t_s = v[1];
+  return true;
+}
+
+// ----------------------------------------------------------------------------- whole logs
+
+LogReadBack read_master_log(const std::filesystem::path& path, std::vector<MasterStepLog>& log,
+                            std::vector<rt::StepRecord>& records) {
+  MasterLogReader in(path);
+  MasterStepLog l;
+  rt::StepRecord r;
+  while (in.next(l, r)) {
     log.push_back(l);
-    records.push_back(record_of(v[1], v[13], v[14], v[15]));
-    rb.last_t_s = v[1];
+    records.push_back(r);
   }
-  return rb;
+  return in.read_back();
 }
 
 LogReadBack read_slave_log(const std::filesystem::path& path, std::vector<SlaveStepLog>& log,
                            std::vector<rt::StepRecord>& records) {
-  LogLines in(path, {"step", "t_s", "state", "command_counter", "command_fresh", "dropped", "current_mA",
-                     "pressure_kPa", "measured_kPa", "pilot_raw", "tet_us", "io_us", "wake_latency_us"});
-  LogReadBack rb;
-  std::vector<double> v;
-  while (in.next(v, rb)) {
-    SlaveStepLog l;
-    l.step = static_cast<std::uint32_t>(v[0]);
-    l.state = static_cast<NodeState>(static_cast<int>(v[2]));
-    l.command_counter = static_cast<std::uint64_t>(v[3]);
-    l.command_fresh = v[4] != 0.0;
-    l.dropped = static_cast<std::uint16_t>(v[5]);
-    l.current_mA = v[6];
-    l.pressure_kPa = v[7];
-    l.measured_kPa = v[8];
-    l.pilot_raw = static_cast<std::uint16_t>(v[9]);
+  SlaveLogReader in(path);
+  SlaveStepLog l;
+  rt::StepRecord r;
+  while (in.next(l, r)) {
     log.push_back(l);
-    records.push_back(record_of(v[1], v[10], v[11], v[12]));
-    rb.last_t_s = v[1];
+    records.push_back(r);
   }
-  return rb;
+  return in.read_back();
 }
 
 }  // namespace lash::hil

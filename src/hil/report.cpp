@@ -420,6 +420,7 @@ std::string run_report_json(const RunReport& r) {
     for (auto& [k, v] : sj.items()) out[k] = v;
   }
   out["out_dir"] = r.out_dir;
+  if (r.session_peak_rss_kB >= 0) out["session_peak_rss_kB"] = r.session_peak_rss_kB;
   return out.dump(2) + "\n";
 }
 

@@ -4,11 +4,13 @@
 
 #include <cmath>
 #include <deque>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
 #include "lash/io/error.hpp"
 #include "lash/io/table.hpp"
+#include "csv_lines.hpp"
 
 namespace lash::hil {
 
@@ -196,6 +198,195 @@ FrameSchedule read_schedule(const std::filesystem::path& master_csv, const std::
   return s;
 }
 
+// ----------------------------------------------------------------------------- streamed
+
+namespace {
+
+std::int64_t integer_value(const detail::LogLines& in, const char* col, double v, double min) {
+  if (!(v >= min) || v != std::floor(v) || v > 9e15)
+    throw InputError(in.file(), in.line(), col,
+                     "must be an integer >= " + std::to_string(static_cast<long long>(min)) + ", got " +
+                         std::to_string(v));
+  return static_cast<std::int64_t>(v);
+}
+
+bool has_calibration_columns(const std::filesystem::path& master_csv) {
+  std::string header;
+  std::ifstream in(master_csv);
+  std::getline(in, header);
+  const std::string first = calibration_fields()[0].name;
+  std::string cell;
+  for (char c : header + ",") {
+    if (c == ',') {
+      if (cell == first) return true;
+      cell.clear();
+    } else if (c != '\r') {
+      cell += c;
+    }
+  }
+  return false;
+}
+
+std::vector<std::string> master_schedule_columns(bool calibration) {
+  std::vector<std::string> c{"control_step", "sensor_seq", "dropped"};
+  if (calibration)
+    for (const auto& f : calibration_fields()) c.emplace_back(f.name);
+  return c;
+}
+
+const std::vector<std::string> kSlaveScheduleColumns{"step", "command_counter", "command_fresh", "dropped"};
+
+}  // namespace
+
+struct ScheduleFiles::Impl {
+  std::filesystem::path master_csv, slave_csv;
+  bool calibration = false;
+  std::optional<detail::LogLines> m, s;
+  std::size_t im = 0, is = 0;  ///< the control step / slave step of the row in mv / sv
+  bool m_have = false, s_have = false;
+  std::vector<double> mv, sv;
+  LogReadBack rb;
+  /// Reads master rows up to the m-th control row.
+  void master_to(std::size_t want) {
+    if (!m) {
+      m.emplace(master_csv, master_schedule_columns(calibration));
+      m_have = false;
+    }
+    while (!m_have || im < want) {
+      bool got = false;
+      while (m->next(mv, rb))
+        if (mv[0] >= 0) {
+          got = true;
+          break;
+        }
+      if (!got) throw std::logic_error("hil schedule: master.csv read past its end");
+      if (m_have) ++im;
+      m_have = true;
+    }
+  }
+  void slave_to(std::size_t want) {
+    if (!s) {
+      s.emplace(slave_csv, kSlaveScheduleColumns);
+      s_have = false;
+    }
+    while (!s_have || is < want) {
+      if (!s->next(sv, rb)) throw std::logic_error("hil schedule: slave.csv read past its end");
+      if (s_have) ++is;
+      s_have = true;
+    }
+  }
+};
+
+ScheduleFiles::ScheduleFiles(const std::filesystem::path& master_csv, const std::filesystem::path& slave_csv)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->master_csv = master_csv;
+  impl_->slave_csv = slave_csv;
+  impl_->calibration = has_calibration_columns(master_csv);
+  const auto fields = calibration_fields();
+  LogReadBack rb;
+  std::vector<double> v;
+  {  // master.csv: the checks of read_schedule, the control steps and the calibration changes
+    detail::LogLines in(master_csv, master_schedule_columns(impl_->calibration));
+    while (in.next(v, rb)) {
+      const std::int64_t c = integer_value(in, "control_step", v[0], -1);
+      if (c < 0) continue;
+      if (c != static_cast<std::int64_t>(logged_))
+        throw InputError(in.file(), in.line(), "control_step",
+                         "control steps must count 0, 1, 2, … (expected " + std::to_string(logged_) + ")");
+      (void)integer_value(in, "sensor_seq", v[1], -1);
+      (void)integer_value(in, "dropped", v[2], 0);
+      ++logged_;
+      if (!impl_->calibration) continue;
+      CalibrationPage p;
+      for (std::size_t j = 0; j < fields.size(); ++j) {
+        if (!std::isfinite(v[3 + j])) throw InputError(in.file(), in.line(), fields[j].name, "not a finite number");
+        p.*fields[j].member = v[3 + j];
+      }
+      if (calibration_.empty() || !(calibration_.back().page == p)) calibration_.push_back({c, p});
+    }
+    if (logged_ == 0)
+      throw InputError(master_csv.string(), 0, "control_step", "no control step (control_step >= 0) in the log");
+  }
+  {  // slave.csv
+    detail::LogLines in(slave_csv, kSlaveScheduleColumns);
+    while (in.next(v, rb)) {
+      if (integer_value(in, "step", v[0], 0) != static_cast<std::int64_t>(slave_steps_))
+        throw InputError(in.file(), in.line(), "step",
+                         "slave steps must count 0, 1, 2, … (expected " + std::to_string(slave_steps_) + ")");
+      if (integer_value(in, "command_fresh", v[2], 0) > 1)
+        throw InputError(in.file(), in.line(), "command_fresh", "must be 0 or 1");
+      (void)integer_value(in, "command_counter", v[1], 0);
+      (void)integer_value(in, "dropped", v[3], 0);
+      ++slave_steps_;
+    }
+  }
+  {  // replayable_control_steps(): the first control step using a sensor frame past the slave's end
+    detail::LogLines in(master_csv, master_schedule_columns(false));
+    replayable_ = logged_;
+    std::size_t m = 0;
+    while (in.next(v, rb)) {
+      if (v[0] < 0) continue;
+      if (v[1] >= static_cast<double>(slave_steps_)) {
+        replayable_ = m;
+        break;
+      }
+      ++m;
+    }
+  }
+  steps_ = logged_;
+}
+
+ScheduleFiles::~ScheduleFiles() = default;
+
+FrameUse ScheduleFiles::master_use(std::size_t m) {
+  if (impl_->m && impl_->m_have && m < impl_->im) throw std::logic_error("hil schedule: master step asked backwards");
+  impl_->master_to(m);
+  return FrameUse{static_cast<std::int64_t>(impl_->mv[1]), impl_->mv[2] > 0};
+}
+
+FrameUse ScheduleFiles::slave_use(std::size_t s) {
+  if (impl_->s && impl_->s_have && s < impl_->is) throw std::logic_error("hil schedule: slave step asked backwards");
+  impl_->slave_to(s);
+  const auto& v = impl_->sv;
+  return FrameUse{v[2] != 0 ? static_cast<std::int64_t>(v[1]) : -1, v[3] > 0};
+}
+
+struct TraceCompare::Impl {
+  explicit Impl(const std::filesystem::path& p) : in(p, {"control_step", "measured_kPa", "current_mA"}) { advance(); }
+  void advance() {
+    have = false;
+    while (in.next(v, rb)) {
+      const std::int64_t c = integer_value(in, "control_step", v[0], -1);
+      if (c < 0) continue;
+      have = true;
+      return;
+    }
+  }
+  detail::LogLines in;
+  std::vector<double> v;
+  LogReadBack rb;
+  bool have = false;
+};
+
+TraceCompare::TraceCompare(const std::filesystem::path& master_csv) : impl_(std::make_unique<Impl>(master_csv)) {}
+TraceCompare::~TraceCompare() = default;
+
+void TraceCompare::add(const MasterStepLog& sim) {
+  if (sim.control_step < 0) return;
+  auto& t = *impl_;
+  const auto m = static_cast<double>(sim.control_step);
+  while (t.have && t.v[0] < m) t.advance();
+  while (t.have && t.v[0] == m) {
+    ++d_.compared;
+    const double dp = std::abs(t.v[1] - sim.measured_kPa);
+    const double di = std::abs(t.v[2] - sim.current_mA);
+    if ((dp > 0 || di > 0) && !d_.first_diff_step) d_.first_diff_step = sim.control_step;
+    d_.max_abs_diff_kPa = std::max(d_.max_abs_diff_kPa, dp);
+    d_.max_abs_diff_mA = std::max(d_.max_abs_diff_mA, di);
+    t.advance();
+  }
+}
+
 std::vector<MasterStepLog> read_master_trace(const std::filesystem::path& master_csv) {
   TableOptions o;
   o.columns = {"control_step", "measured_kPa", "current_mA"};
@@ -226,10 +417,22 @@ SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& m
 }
 
 namespace {
-MasterConfig streaming(MasterConfig mc, const FrameSchedule& schedule) {
+class FrameScheduleSource final : public ScheduleSource {
+ public:
+  explicit FrameScheduleSource(const FrameSchedule& s) : s_(s) {}
+  std::size_t master_steps() const override { return s_.master_steps(); }
+  std::size_t slave_steps() const override { return s_.slave_steps(); }
+  FrameUse master_use(std::size_t m) override { return s_.master_use(m); }
+  FrameUse slave_use(std::size_t s) override { return s_.slave_use(s); }
+
+ private:
+  const FrameSchedule& s_;
+};
+
+MasterConfig streaming(MasterConfig mc, const std::vector<MasterConfig::CalibrationChange>& calibration) {
   mc.log_capacity = 1;  // one row, handed to the sink after each step
   mc.bus_log_capacity = 1;
-  if (!schedule.calibration.empty()) mc.calibration_schedule = schedule.calibration;
+  if (!calibration.empty()) mc.calibration_schedule = calibration;
   return mc;
 }
 SlaveConfig streaming(SlaveConfig sc) {
@@ -241,10 +444,24 @@ SlaveConfig streaming(SlaveConfig sc) {
 BenchSimulation::BenchSimulation(const BenchLayout& layout, const MasterConfig& master_cfg,
                                  const SlaveConfig& slave_cfg, const FrameSchedule& schedule,
                                  const SimulationSink& sink)
+    : BenchSimulation(layout, master_cfg, slave_cfg, std::make_unique<FrameScheduleSource>(schedule),
+                      schedule.calibration, sink) {}
+
+BenchSimulation::BenchSimulation(const BenchLayout& layout, const MasterConfig& master_cfg,
+                                 const SlaveConfig& slave_cfg, ScheduleSource& schedule,
+                                 const std::vector<MasterConfig::CalibrationChange>& calibration,
+                                 const SimulationSink& sink)
+    : BenchSimulation(layout, master_cfg, slave_cfg, std::unique_ptr<ScheduleSource>(), calibration, sink, &schedule) {}
+
+BenchSimulation::BenchSimulation(const BenchLayout& layout, const MasterConfig& master_cfg,
+                                 const SlaveConfig& slave_cfg, std::unique_ptr<ScheduleSource> owned,
+                                 const std::vector<MasterConfig::CalibrationChange>& calibration,
+                                 const SimulationSink& sink, ScheduleSource* borrowed)
     : layout_(layout),
-      schedule_(schedule),
+      owned_(std::move(owned)),
+      schedule_(borrowed ? *borrowed : *owned_),
       sink_(sink),
-      master_(layout, streaming(master_cfg, schedule)),
+      master_(layout, streaming(master_cfg, calibration)),
       slave_(layout, streaming(slave_cfg)),
       T_(master_cfg.controller.pid.dt_s),
       mb_(std::make_unique<FeedBus>()),
@@ -271,7 +488,7 @@ void BenchSimulation::master_step(can::Bus& bus, double t) {
   master_.clear_step_logs();
 }
 
-bool BenchSimulation::slave_ready() const {
+bool BenchSimulation::slave_ready() {
   return s_ < static_cast<std::int64_t>(schedule_.slave_steps()) &&
          schedule_.slave_use(static_cast<std::size_t>(s_)).seq < commands_->size();
 }
@@ -324,7 +541,15 @@ SimulationResult BenchSimulation::finish() {
 SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& master_cfg,
                                 const SlaveConfig& slave_cfg, const FrameSchedule& schedule,
                                 const SimulationSink& sink) {
-  BenchSimulation sim(layout, master_cfg, slave_cfg, schedule, sink);
+  FrameScheduleSource src(schedule);
+  return simulate_bench(layout, master_cfg, slave_cfg, src, schedule.calibration, sink);
+}
+
+SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& master_cfg,
+                                const SlaveConfig& slave_cfg, ScheduleSource& schedule,
+                                const std::vector<MasterConfig::CalibrationChange>& calibration,
+                                const SimulationSink& sink) {
+  BenchSimulation sim(layout, master_cfg, slave_cfg, schedule, calibration, sink);
   while (sim.advance()) {
   }
   return sim.finish();

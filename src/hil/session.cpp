@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/file.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -15,6 +16,7 @@
 #include "lash/hil/handover.hpp"
 #include "lash/hil/launch.hpp"
 #include "lash/hil/netns.hpp"
+#include "lash/hil/report_logs.hpp"
 #include "lash/hil/schedule.hpp"
 #include "lash/hil/simulate.hpp"
 #include "lash/io/atomic_file.hpp"
@@ -130,6 +132,8 @@ class SessionRun {
     stop_slaves();
     collect();
     report(L, mc, sc);
+    struct rusage ru {};
+    if (getrusage(RUSAGE_SELF, &ru) == 0) rep_.session_peak_rss_kB = ru.ru_maxrss;
     AtomicFile f(dir_ / "report.json");
     f.stream() << run_report_json(rep_);
     f.commit();
@@ -277,16 +281,15 @@ class SessionRun {
     have_master_ = read_run(master_.result_fd, mrun_);
     const auto master_csv = dir_ / "master.csv";
     if (std::filesystem::exists(master_csv)) {
-      const LogReadBack rb = read_master_log(master_csv, mrun_.log, mrun_.loop.records);
-      if (!have_master_ && rb.rows > 0) {
+      logs_.master = scan_master_log(master_csv);
+      const NodeLogScan& ms = *logs_.master;
+      if (!have_master_ && ms.read.rows > 0) {
         have_master_ = true;
-        recover(mrun_.stats, rb, mrun_.log.back().state);
-        std::int64_t last_m = -1;
-        for (const auto& l : mrun_.log) last_m = std::max(last_m, l.control_step);
-        mrun_.stats.control_steps = last_m + 1;
-        rep_.master_recovered = LogRecovery{master_csv.string(), rb.rows, rb.cut_lines, rb.last_t_s};
+        recover(mrun_.stats, ms.read, ms.last_state);
+        mrun_.stats.control_steps = ms.last_control_step + 1;
+        rep_.master_recovered = LogRecovery{master_csv.string(), ms.read.rows, ms.read.cut_lines, ms.read.last_t_s};
         say("the master handed nothing over (status " + std::to_string(master_.exit.status) + "): recovered " +
-            std::to_string(rb.rows) + " rows up to t = " + format_double(rb.last_t_s) + " s from " +
+            std::to_string(ms.read.rows) + " rows up to t = " + format_double(ms.read.last_t_s) + " s from " +
             master_csv.string());
       }
     }
@@ -297,14 +300,16 @@ class SessionRun {
       if (!handed) r = SlaveRun{};
       const auto csv = dir_ / (slave_name(i + 1) + ".csv");
       if (std::filesystem::exists(csv)) {
-        const LogReadBack rb = read_slave_log(csv, r.log, r.loop.records);
-        if (!handed && rb.rows > 0) {
-          recover(r.stats, rb, r.log.back().state);
+        NodeLogScan ss = scan_slave_log(csv);
+        if (!handed && ss.read.rows > 0) {
+          recover(r.stats, ss.read, ss.last_state);
           r.stats.connected = true;
-          if (i == 0) rep_.slave_recovered = LogRecovery{csv.string(), rb.rows, rb.cut_lines, rb.last_t_s};
+          if (i == 0) rep_.slave_recovered = LogRecovery{csv.string(), ss.read.rows, ss.read.cut_lines, ss.read.last_t_s};
           say(slave_name(i + 1) + " handed nothing over (status " + std::to_string(s.exit.status) + "): recovered " +
-              std::to_string(rb.rows) + " rows up to t = " + format_double(rb.last_t_s) + " s from " + csv.string());
+              std::to_string(ss.read.rows) + " rows up to t = " + format_double(ss.read.last_t_s) + " s from " +
+              csv.string());
         }
+        if (i == 0) logs_.slave = std::move(ss);
       }
       sruns_.push_back(std::move(r));
       rep_.slave_exits.push_back(s.exit);
@@ -323,35 +328,12 @@ class SessionRun {
     st.period_ns = static_cast<std::int64_t>(std::llround(o_.settings.step_s * 1e9));
   }
 
-  // ---- report (report.hpp): against the ideal-schedule simulation and the replay of the
+  // ---- report (report_logs.hpp): from the logs on disk, read row by row (the session's memory
+  // does not grow with the run), against the ideal-schedule simulation and the replay of the
   // schedule the nodes logged.
   void report(const BenchLayout& L, const MasterConfig& mc, const SlaveConfig& sc) {
-    std::vector<MasterStepLog> simulated;
-    if (have_master_ && mrun_.stats.control_steps > 0) {
-      // The ideal frame schedule, with the calibration writes the run logged (XCP) at their steps.
-      FrameSchedule ideal = ideal_schedule(static_cast<std::size_t>(mrun_.stats.control_steps));
-      ideal.calibration = observed_schedule(mrun_.log, {}).calibration;
-      simulated = simulate_bench(L, mc, sc, ideal).master;
-    }
-    make_run_report(rep_, have_master_ ? &mrun_ : nullptr, sruns_, simulated,
-                    o_.settings.scenario ? &*o_.settings.scenario : nullptr);
-    if (simulated.empty()) return;
-    if (sruns_.size() != 1 || sruns_[0].log.empty()) {
-      rep_.observed_schedule_note = "not replayed: the schedule of one slave from start to end is needed";
-      return;
-    }
-    try {
-      FrameSchedule fs = observed_schedule(mrun_.log, sruns_[0].log);
-      const std::size_t kept = replayable_control_steps(fs);
-      if (kept < fs.master.size()) {  // a killed slave's log ends before the master's
-        fs.master.resize(kept);
-        rep_.observed_schedule_note =
-            "replayed the first " + std::to_string(kept) + " control steps: the slave's log ends before the master's";
-      }
-      rep_.vs_observed_schedule = compare_with_simulation(mrun_.log, simulate_bench(L, mc, sc, fs).master);
-    } catch (const std::invalid_argument& e) {
-      rep_.observed_schedule_note = std::string("not replayed: ") + e.what();
-    }
+    make_run_report_from_logs(rep_, have_master_ ? &mrun_ : nullptr, sruns_, logs_, L, mc, sc,
+                              o_.settings.scenario ? &*o_.settings.scenario : nullptr);
   }
 
   const SessionOptions& o_;
@@ -365,6 +347,7 @@ class SessionRun {
   MasterRun mrun_;
   bool have_master_ = false;
   std::vector<SlaveRun> sruns_;
+  RunLogs logs_;
 };
 }  // namespace
 

@@ -9,14 +9,17 @@
 
 namespace lash::hil {
 
-SimulationFileRun simulate_to_csv(const BenchLayout& layout, const MasterConfig& master, const SlaveConfig& slave,
-                                  const FrameSchedule& schedule, double dt_s, const std::filesystem::path& out,
-                                  const BenchScenario* scenario, const std::vector<MasterStepLog>* compare_with) {
+namespace {
+
+/// The CSV of a simulation: `simulate(sink)` runs it (simulate_bench), `compare(row)` sees each
+/// simulated control-step row of the master.
+template <class Simulate, class Compare>
+SimulationFileRun run_to_csv(double dt_s, const std::filesystem::path& out, const BenchScenario* scenario,
+                             Simulate simulate, Compare compare) {
   SimulationFileRun run;
   AtomicFile f(out);
   f.stream() << "control_step,t_s,reference_kPa,measured_kPa,current_mA,pressure_kPa\n";
   StepResponseStream step(dt_s);
-  SimulationDiff diff;
   std::optional<ScenarioScore> score;  // scenario figures, accumulated row by row
   if (scenario) score.emplace(*scenario, dt_s);
   // Control step m pairs with slave step m; either may come first.
@@ -50,18 +53,7 @@ SimulationFileRun simulate_to_csv(const BenchLayout& layout, const MasterConfig&
   SimulationSink sink;
   sink.master = [&](const MasterStepLog& l) {
     if (l.control_step < 0) return;
-    if (compare_with) {  // compare_with_simulation(), one simulated row at a time
-      const auto m = static_cast<std::size_t>(l.control_step);
-      if (m < compare_with->size() && (*compare_with)[m].control_step == l.control_step) {
-        const MasterStepLog& e = (*compare_with)[m];
-        ++diff.compared;
-        const double dp = std::abs(e.measured_kPa - l.measured_kPa);
-        const double di = std::abs(e.current_mA - l.current_mA);
-        if ((dp > 0 || di > 0) && !diff.first_diff_step) diff.first_diff_step = l.control_step;
-        diff.max_abs_diff_kPa = std::max(diff.max_abs_diff_kPa, dp);
-        diff.max_abs_diff_mA = std::max(diff.max_abs_diff_mA, di);
-      }
-    }
+    compare(l);
     masters.push_back(l);
     emit();
   };
@@ -69,15 +61,53 @@ SimulationFileRun simulate_to_csv(const BenchLayout& layout, const MasterConfig&
     slaves.push_back(l);
     emit();
   };
-  const SimulationResult r = simulate_bench(layout, master, slave, schedule, sink);
+  const SimulationResult r = simulate(sink);
   f.commit();
   run.compensation = r.compensation;
-  if (compare_with) run.vs_log = diff;
   if (scenario) {
     run.scenario = score->result(r.compensation);
   } else {
     run.step = step.result();
   }
+  return run;
+}
+
+}  // namespace
+
+SimulationFileRun simulate_to_csv(const BenchLayout& layout, const MasterConfig& master, const SlaveConfig& slave,
+                                  const FrameSchedule& schedule, double dt_s, const std::filesystem::path& out,
+                                  const BenchScenario* scenario, const std::vector<MasterStepLog>* compare_with) {
+  SimulationDiff diff;
+  SimulationFileRun run = run_to_csv(
+      dt_s, out, scenario, [&](const SimulationSink& sink) { return simulate_bench(layout, master, slave, schedule, sink); },
+      [&](const MasterStepLog& l) {
+        if (!compare_with) return;  // compare_with_simulation(), one simulated row at a time
+        const auto m = static_cast<std::size_t>(l.control_step);
+        if (m < compare_with->size() && (*compare_with)[m].control_step == l.control_step) {
+          const MasterStepLog& e = (*compare_with)[m];
+          ++diff.compared;
+          const double dp = std::abs(e.measured_kPa - l.measured_kPa);
+          const double di = std::abs(e.current_mA - l.current_mA);
+          if ((dp > 0 || di > 0) && !diff.first_diff_step) diff.first_diff_step = l.control_step;
+          diff.max_abs_diff_kPa = std::max(diff.max_abs_diff_kPa, dp);
+          diff.max_abs_diff_mA = std::max(diff.max_abs_diff_mA, di);
+        }
+      });
+  if (compare_with) run.vs_log = diff;
+  return run;
+}
+
+SimulationFileRun simulate_to_csv(const BenchLayout& layout, const MasterConfig& master, const SlaveConfig& slave,
+                                  ScheduleFiles& schedule, double dt_s, const std::filesystem::path& out,
+                                  const BenchScenario* scenario, const std::filesystem::path& compare_with) {
+  TraceCompare cmp(compare_with);
+  SimulationFileRun run = run_to_csv(
+      dt_s, out, scenario,
+      [&](const SimulationSink& sink) {
+        return simulate_bench(layout, master, slave, schedule, schedule.calibration(), sink);
+      },
+      [&](const MasterStepLog& l) { cmp.add(l); });
+  run.vs_log = cmp.result();
   return run;
 }
 

@@ -33,6 +33,9 @@ std::optional<LogEntry> parse_log_line(std::string_view line, std::string& error
 /// `(1600000000.123456) vcan0 123#DEADBEEF` (no newline); time rounded to 1 µs, written as 0
 /// when candump cannot hold it (writable_times).
 std::string format_log_line(const Frame& frame, std::string_view interface);
+/// The same with `fraction_digits` (6 or 9) digits of the second: 9 keeps a time to the
+/// nanosecond (read_log reads up to 9), as `lash can dump` spools the frames of a relative format.
+std::string format_log_line(const Frame& frame, std::string_view interface, unsigned fraction_digits);
 
 /// Log file formats, chosen by extension: .asc (Vector ASCII), .blf (Vector binary
 /// logging format), .trc (PEAK trace), anything else candump (-L or default output).

@@ -4,6 +4,7 @@
 /// over in an inherited memory file when it stops, and its logs on disk, read back (also when
 /// the node was killed and handed nothing over). Not real-time code.
 #include <filesystem>
+#include <memory>
 #include <vector>
 
 #include "lash/hil/node_run.hpp"
@@ -18,6 +19,39 @@ struct LogReadBack {
   std::size_t cut_lines = 0;   ///< an unfinished last line (the node was killed mid-write)
   double last_t_s = -1.0;      ///< t_s of the last row [s]; −1: no row
 };
+/// A node's CSV log read row by row in constant memory (what read_master_log / read_slave_log
+/// collect): next() fills the next whole row and its loop record, false at the end (a last line
+/// cut short is counted in read_back().cut_lines, not returned). Throws InputError as they do.
+class MasterLogReader {
+ public:
+  explicit MasterLogReader(const std::filesystem::path& path);
+  ~MasterLogReader();
+  MasterLogReader(const MasterLogReader&) = delete;
+  MasterLogReader& operator=(const MasterLogReader&) = delete;
+  bool next(MasterStepLog& row, rt::StepRecord& record);
+  const LogReadBack& read_back() const noexcept { return rb_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  LogReadBack rb_;
+};
+class SlaveLogReader {
+ public:
+  explicit SlaveLogReader(const std::filesystem::path& path);
+  ~SlaveLogReader();
+  SlaveLogReader(const SlaveLogReader&) = delete;
+  SlaveLogReader& operator=(const SlaveLogReader&) = delete;
+  bool next(SlaveStepLog& row, rt::StepRecord& record);
+  const LogReadBack& read_back() const noexcept { return rb_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  LogReadBack rb_;
+};
+
+/// The whole log in memory (tests, tools): every row and its record appended to log / records.
 LogReadBack read_master_log(const std::filesystem::path& path, std::vector<MasterStepLog>& log,
                             std::vector<rt::StepRecord>& records);
 LogReadBack read_slave_log(const std::filesystem::path& path, std::vector<SlaveStepLog>& log,

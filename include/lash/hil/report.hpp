@@ -187,6 +187,7 @@ struct RunReport {
   NodeExit master_exit;
   std::vector<NodeExit> slave_exits;      ///< one per slave process, in start order
   std::vector<SlaveRestart> restarts;
+  long session_peak_rss_kB = -1;          ///< the session process's own peak resident set [kB] (−1: not measured)
   // Computed by make_run_report.
   bool have_master = false, have_slave = false;
   NodeFigures master, slave;              ///< slave: the first slave process

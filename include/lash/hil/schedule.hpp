@@ -15,12 +15,14 @@
 /// functions, so that the replay equals the emulation sample for sample, late frames or not.
 #include <cstddef>
 #include <cstdint>
+#include <algorithm>
 #include <filesystem>
 #include <functional>
 #include <memory>
 #include <vector>
 
 #include "lash/hil/nodes.hpp"
+#include "lash/hil/report.hpp"
 #include "lash/hil/simulate.hpp"
 
 namespace lash::hil {
@@ -56,6 +58,18 @@ struct FrameSchedule {
   }
 };
 
+/// A schedule given step by step, for a replay whose schedule is not kept in memory (the session
+/// reads its nodes' logs as the replay goes, report_logs.hpp). simulate_bench asks for master
+/// steps m = 0, 1, … and slave steps s = 0, 1, …, each maybe more than once, never backwards.
+class ScheduleSource {
+ public:
+  virtual ~ScheduleSource() = default;
+  virtual std::size_t master_steps() const = 0;
+  virtual std::size_t slave_steps() const = 0;
+  virtual FrameUse master_use(std::size_t m) = 0;
+  virtual FrameUse slave_use(std::size_t s) = 0;
+};
+
 /// What simulate_bench's streaming form hands on, row by row, as the nodes' steps produce them.
 struct SimulationSink {
   std::function<void(const MasterStepLog&)> master;  ///< every master step (the connecting step included)
@@ -82,6 +96,54 @@ std::size_t replayable_control_steps(const FrameSchedule& s) noexcept;
 /// the file, line and column of a missing column or a value that is not a step number.
 FrameSchedule read_schedule(const std::filesystem::path& master_csv, const std::filesystem::path& slave_csv);
 
+/// read_schedule() in constant memory: the logs are checked in a first pass (the errors of
+/// read_schedule, naming file, line and column; a last line cut short, of a killed node, is
+/// left out), then read again step by step as simulate_bench asks for them.
+class ScheduleFiles final : public ScheduleSource {
+ public:
+  ScheduleFiles(const std::filesystem::path& master_csv, const std::filesystem::path& slave_csv);
+  ~ScheduleFiles() override;
+  ScheduleFiles(const ScheduleFiles&) = delete;
+  ScheduleFiles& operator=(const ScheduleFiles&) = delete;
+  /// The control steps master.csv holds.
+  std::size_t logged_control_steps() const noexcept { return logged_; }
+  /// replayable_control_steps() of the schedule.
+  std::size_t replayable() const noexcept { return replayable_; }
+  /// Replays only the first `control_steps` (at most the logged ones).
+  void limit(std::size_t control_steps) noexcept { steps_ = std::min(control_steps, logged_); }
+  /// FrameSchedule::calibration of the schedule.
+  const std::vector<MasterConfig::CalibrationChange>& calibration() const noexcept { return calibration_; }
+
+  std::size_t master_steps() const override { return steps_; }
+  std::size_t slave_steps() const override { return slave_steps_; }
+  FrameUse master_use(std::size_t m) override;
+  FrameUse slave_use(std::size_t s) override;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  std::size_t logged_ = 0, replayable_ = 0, steps_ = 0, slave_steps_ = 0;
+  std::vector<MasterConfig::CalibrationChange> calibration_;
+};
+
+/// compare_with_simulation() of a master.csv's control rows (read_master_trace: control_step,
+/// measured_kPa, current_mA) with simulated master rows given one at a time in ascending control
+/// step, reading the log as they come (constant memory). Throws InputError as read_master_trace.
+class TraceCompare {
+ public:
+  explicit TraceCompare(const std::filesystem::path& master_csv);
+  ~TraceCompare();
+  TraceCompare(const TraceCompare&) = delete;
+  TraceCompare& operator=(const TraceCompare&) = delete;
+  void add(const MasterStepLog& simulated);
+  const SimulationDiff& result() const noexcept { return d_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  SimulationDiff d_;
+};
+
 /// The control steps of a master.csv as a master log (control_step, measured_kPa, current_mA
 /// filled; the rows before the handshake skipped), to compare with a simulation. Throws InputError.
 std::vector<MasterStepLog> read_master_trace(const std::filesystem::path& master_csv);
@@ -101,6 +163,11 @@ class BenchSimulation {
   /// not see the CONNECT. `schedule` and `sink` must outlive the simulation.
   BenchSimulation(const BenchLayout& layout, const MasterConfig& master, const SlaveConfig& slave,
                   const FrameSchedule& schedule, const SimulationSink& sink);
+  /// The same on a schedule read as the replay goes (ScheduleFiles) and its calibration changes;
+  /// `schedule` and `calibration` must outlive the simulation.
+  BenchSimulation(const BenchLayout& layout, const MasterConfig& master, const SlaveConfig& slave,
+                  ScheduleSource& schedule, const std::vector<MasterConfig::CalibrationChange>& calibration,
+                  const SimulationSink& sink);
   ~BenchSimulation();
   BenchSimulation(const BenchSimulation&) = delete;
   BenchSimulation& operator=(const BenchSimulation&) = delete;
@@ -116,11 +183,15 @@ class BenchSimulation {
   const MasterNode& master() const noexcept { return master_; }
 
  private:
+  BenchSimulation(const BenchLayout& layout, const MasterConfig& master, const SlaveConfig& slave,
+                  std::unique_ptr<ScheduleSource> owned, const std::vector<MasterConfig::CalibrationChange>& calibration,
+                  const SimulationSink& sink, ScheduleSource* borrowed = nullptr);
   void master_step(can::Bus& bus, double t);
-  bool slave_ready() const;
+  bool slave_ready();
   void slave_step();
   const BenchLayout& layout_;
-  const FrameSchedule& schedule_;
+  std::unique_ptr<ScheduleSource> owned_;  // a FrameSchedule's adapter
+  ScheduleSource& schedule_;
   const SimulationSink& sink_;
   MasterNode master_;
   SlaveNode slave_;
@@ -146,5 +217,11 @@ SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& m
 /// The rows are those of the form above, bit for bit, in the same order per node.
 SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& master, const SlaveConfig& slave,
                                 const FrameSchedule& schedule, const SimulationSink& sink);
+/// The same with the schedule read step by step from `schedule` and the master's calibration
+/// changes given apart (FrameSchedule::calibration).
+SimulationResult simulate_bench(const BenchLayout& layout, const MasterConfig& master, const SlaveConfig& slave,
+                                ScheduleSource& schedule,
+                                const std::vector<MasterConfig::CalibrationChange>& calibration,
+                                const SimulationSink& sink);
 
 }  // namespace lash::hil

@@ -2,8 +2,8 @@
 /// @file sim_run.hpp
 /// `lash hil simulate`: the closed loop of the bench through the nodes' step functions
 /// (schedule.hpp: simulate_bench), streamed row by row to a CSV file, so that its memory does not
-/// grow with the duration (a scenario's tracking figures are accumulated row by row; only the
-/// log a --schedule replay compares with is kept). Not real-time code.
+/// grow with the duration (a scenario's tracking figures are accumulated row by row; a
+/// --schedule replay reads the run's logs as it goes). Not real-time code.
 #include <cstddef>
 #include <filesystem>
 #include <optional>
@@ -31,5 +31,11 @@ SimulationFileRun simulate_to_csv(const BenchLayout& layout, const MasterConfig&
                                   const FrameSchedule& schedule, double dt_s, const std::filesystem::path& out,
                                   const BenchScenario* scenario = nullptr,
                                   const std::vector<MasterStepLog>* compare_with = nullptr);
+/// The same for the replay of a run's logs (`lash hil simulate --schedule`) in constant memory:
+/// the schedule read from the logs as the simulation goes (ScheduleFiles), compared with the
+/// control rows of `compare_with` (the run's master.csv) as they come (TraceCompare).
+SimulationFileRun simulate_to_csv(const BenchLayout& layout, const MasterConfig& master, const SlaveConfig& slave,
+                                  ScheduleFiles& schedule, double dt_s, const std::filesystem::path& out,
+                                  const BenchScenario* scenario, const std::filesystem::path& compare_with);
 
 }  // namespace lash::hil
