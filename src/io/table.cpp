@@ -251,7 +251,6 @@ class TextReader {
     const double per_line = static_cast<double>(bytes_first_block_) / static_cast<double>(std::max<std::size_t>(1, lines_first_block_));
     const auto rows_est = static_cast<std::size_t>(static_cast<double>(file_size_) / std::max(1.0, per_line) * 1.05) + 16;
     for (auto& c : t_.cols) c.reserve(rows_est);
-    t_.line_of_row.reserve(rows_est);
     if (numeric) row(sv.data(), sv.data() + sv.size());
   }
 

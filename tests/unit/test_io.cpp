@@ -249,7 +249,7 @@ TEST(Table, NonFiniteRowsAreSkippedAndCountedUnlessStrict) {
   EXPECT_EQ(t.skipped_rows, 4u);
   EXPECT_EQ(t.first_skipped_line, 3);
   EXPECT_EQ(t.cols[0], (std::vector<double>{0, 0.5}));
-  EXPECT_EQ(t.line_of_row, (std::vector<int>{2, 7}));
+  EXPECT_EQ(t.line_of_row.to_vector(), (std::vector<int>{2, 7}));
   o.strict = true;
   try {
     read_table(p, o);
