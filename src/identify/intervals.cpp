@@ -98,6 +98,9 @@ PerSide<SideIntervals> batch_means_intervals(const EstimatorConfig& cfg, std::sp
               x.step(v[kx], y[kx]);
               z.step(v[kz], y[kz]);
             }
+          } else {
+            (void)x;  // one config, one model: never two kinds
+            (void)z;
           }
         });
       });
