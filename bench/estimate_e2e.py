@@ -8,7 +8,8 @@
 2. times the read+parse floor, bench/estimate_floor.cpp (reads the file in 1 MiB blocks and
    parses the three columns with std::from_chars, nothing else) [wall s];
 3. times `lash estimate FILE --model deadzone-deadband --json --timing` whole-process (wall s
-   and peak RSS of the child, getrusage) and reads the estimator's own time from --timing;
+   and peak RSS of the child, getrusage) and reads the default estimator's own time from --timing
+   (the settings chosen from the data, the outlier gate, the guess search and the final run);
 4. prints  ratio = whole-process / (floor + estimator)  (goal <= 1.3)
    and     peak RSS / needed columns (3 x 8 B x rows)  (goal <= 1.3).
 Each figure is the median of R runs (default 3). Paths default to build/bin/lash and

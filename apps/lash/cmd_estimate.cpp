@@ -54,6 +54,7 @@ int run(const CLI::App& sub, const EstimateOptions& o) {
                          format_double(rec.t().back()) + " s)");
   ArrayEstimateOptions eo;
   eo.trace = !o.out.empty() || !o.plot.empty();
+  eo.outputs = eo.trace;  // ŷ and y_sim per sample only for the trace (the NRMSE is summed in the run)
   eo.outlier_gate = o.outlier_gate;
   eo.sampling = &rec.sampling;
   eo.rows_skipped = rec.skipped_rows();
@@ -126,7 +127,7 @@ Command add_estimate(CLI::App& app) {
   sub->add_option("--outlier-gate", o->outlier_gate,
                   "Replace isolated outliers of y beyond this many innovation scales (0 = off; default 12)");
   sub->add_flag("--json", o->json, "Print exactly one JSON object with the result on stdout");
-  sub->add_flag("--timing", o->timing, "Print the estimator's own run time (without file I/O) on stderr");
+  sub->add_flag("--timing", o->timing, "Print the estimator's own run time on stderr (settings from the data, guess search, final run; not the reading nor the intervals)");
   // a later option overrides an earlier one (handy for wrappers that append settings)
   for (auto* opt : sub->get_options())
     if (opt->get_expected_max() == 1 && opt->get_name() != "--nrmse-window")

@@ -57,7 +57,7 @@ def estimate(t: ArrayLike, v: ArrayLike, y: ArrayLike, *, model: str = "deadzone
 
 class Estimator:
     """One estimator fed sample by sample; the k-th sample is at t = k*dt_s [s]."""
-    def __init__(self, model: str, dt_s: float, *, preset: str = "thesis", reguess: bool = False,
+    def __init__(self, model: str, dt_s: float, *, preset: str = "lash", reguess: bool = False,
                  **settings: Any) -> None: ...
     def update(self, v: float, y: float) -> float:
         """One sample; returns the one-step prediction yhat [output unit]."""

@@ -264,13 +264,16 @@ void bind_estimate(pyb::module_& m) {
         "more over sections of the record), as `lash estimate`. Raises lash.InputError (a ValueError) naming the key.");
 
   pyb::class_<Estimator>(m, "Estimator",
-                         "Estimator(model, dt_s, *, preset='thesis', **settings): one estimator fed sample by sample\n"
-                         "(streaming): the preset's static settings (nothing is chosen from data not seen yet), no\n"
-                         "guess search, no outlier gate. dt_s: sample period [s]; settings as for lash.estimate.\n"
+                         "Estimator(model, dt_s, *, preset='lash', **settings): one estimator fed sample by sample\n"
+                         "(streaming): the preset's static settings (nothing is chosen from data not seen yet: give\n"
+                         "the data-dependent ones, e.g. noise={'derivative_threshold': ...}, from `lash estimate\n"
+                         "REC --print-config` of a like record), no guess search, no outlier gate. preset: 'lash'\n"
+                         "(the default, as lash.estimate and `lash estimate`) or 'thesis'. dt_s: sample period [s];\n"
+                         "settings as for lash.estimate.\n"
                          "The k-th sample is at t = k*dt_s. reguess=True: the switching guesses follow the\n"
                          "evidence online (docs/method.md A4.8; input-deadzone and deadzone-deadband).")
       .def(pyb::init<const std::string&, double, const std::string&, const pyb::kwargs&>(), pyb::arg("model"),
-           pyb::arg("dt_s"), pyb::kw_only(), pyb::arg("preset") = "thesis")
+           pyb::arg("dt_s"), pyb::kw_only(), pyb::arg("preset") = "lash")
       .def("update", &Estimator::update, pyb::arg("v"), pyb::arg("y"), pyb::arg("t_s") = pyb::none(),
            "update(v, y, t_s=None) -> yhat: one sample v [input unit], y [output unit] at time t_s [s]\n"
            "(default k*dt_s; the NRMSE window uses it, and a step of t longer than 5 dt_s is a gap: the\n"

@@ -67,9 +67,9 @@ def test_streaming_equals_batch_bit_for_bit(e2_csv):
     # lash.estimate with the thesis preset and the gate off runs exactly that estimator
     batch = lash.estimate(t, v, y, preset="thesis", outlier_gate=0, **E2_SETTINGS)
 
-    one = lash.Estimator("deadzone-deadband", dt, **E2_SETTINGS)
+    one = lash.Estimator("deadzone-deadband", dt, preset="thesis", **E2_SETTINGS)
     yhat1 = np.array([one.update(a, b, t_s=ts) for a, b, ts in zip(v, y, t)])
-    many = lash.Estimator("deadzone-deadband", dt, **E2_SETTINGS)
+    many = lash.Estimator("deadzone-deadband", dt, preset="thesis", **E2_SETTINGS)
     yhat2 = np.concatenate([many.update_many(v[:5000], y[:5000], t=t[:5000]),
                             many.update_many(v[5000:], y[5000:], t=t[5000:])])
     assert yhat1.tobytes() == yhat2.tobytes() == batch.yhat.tobytes()
@@ -93,7 +93,7 @@ def test_gap_restarts_streaming_and_batch_alike(e2_csv):
     dt = t[1] - t[0]
     batch = lash.estimate(t, v, y, preset="thesis", outlier_gate=0, **E2_SETTINGS)
     assert batch.dt_s == (t[-1] - t[0] - (t[6000] - t[5999])) / (len(t) - 2)  # the gap is not in dt
-    many = lash.Estimator("deadzone-deadband", batch.dt_s, **E2_SETTINGS)
+    many = lash.Estimator("deadzone-deadband", batch.dt_s, preset="thesis", **E2_SETTINGS)
     assert many.update_many(v, y, t=t).tobytes() == batch.yhat.tobytes()
     assert many.result().json == batch.json
     # the same samples on an even time base (no gap): no restart, another estimate
@@ -107,12 +107,40 @@ def test_default_time_base_is_k_dt():
     plant = lash.Plant.from_toml(os.path.join(SRC, "config/plants/thesis_eq34.toml"), dt_s=dt)
     v = lash.signal("sine", 60.0, dt, amplitude=600.0)
     tr = plant.simulate(v, noise_variance=10.0, seed=4)
-    e = lash.Estimator("deadzone-deadband", dt, guess_left=-350, guess_right=350, nrmse_window=[5.0, 50.0])
+    e = lash.Estimator("deadzone-deadband", dt, guess_left=-350, guess_right=350, nrmse_window=[5.0, 50.0],
+                       preset="thesis")
     e.update_many(tr["v"], tr["y"])
     b = lash.estimate(np.arange(len(v)) * dt, tr["v"], tr["y"], guess_left=-350, guess_right=350,
                       nrmse_window=[5.0, 50.0], preset="thesis", outlier_gate=0)
     assert e.result().json == b.json
     assert b.nrmse_window_s == (5.0, 50.0)
+
+
+def test_default_preset_is_lash_everywhere(e2_csv):
+    """One default preset: lash.Estimator, lash.estimate and `lash estimate` all default to 'lash'.
+    The streaming Estimator runs lash's static settings; given the settings `lash estimate
+    --print-config` chose from the record, it is lash.estimate (gate off, same guesses) bit for bit,
+    fed in chunks; the thesis preset is another estimator."""
+    import tomllib
+    d = read_csv(e2_csv)
+    t, v, y = d["t"], d["v"], d["y"]
+    guesses = dict(guess_left=-350.0, guess_right=350.0)
+    batch = lash.estimate(t, v, y, outlier_gate=0, **guesses)  # default preset
+    assert batch.to_dict()["preset"] == "lash"
+    cli = json.loads(run_lash("estimate", e2_csv, "--model", "deadzone-deadband", "--guess-left", "-350",
+                              "--guess-right", "350", "--outlier-gate", "0", "--json"))
+    assert cli["preset"] == "lash"
+    chosen = tomllib.loads(run_lash("estimate", e2_csv, "--model", "deadzone-deadband", "--guess-left", "-350",
+                                    "--guess-right", "350", "--outlier-gate", "0", "--print-config"))
+    thr = chosen["noise"]["derivative_threshold"]
+    assert thr != 150.0  # tuned to the record, not the static value
+    stream = lash.Estimator("deadzone-deadband", batch.dt_s, **guesses, noise={"derivative_threshold": thr})
+    yhat = np.concatenate([stream.update_many(v[i:i + 3001], y[i:i + 3001], t=t[i:i + 3001])
+                           for i in range(0, len(t), 3001)])
+    assert yhat.tobytes() == batch.yhat.tobytes()
+    assert stream.result().json == batch.json
+    thesis = lash.Estimator("deadzone-deadband", batch.dt_s, preset="thesis", **guesses)
+    assert thesis.update_many(v, y, t=t).tobytes() != yhat.tobytes()
 
 
 def test_trace_columns(e2_csv):

@@ -23,7 +23,7 @@ def run(reguess):
     n = 12000
     edge = np.where(np.arange(n) < 4000, 2.0, 5.0)  # the right edge moves past the guess 3 at 40 s
     v, y = plant(edge, n)
-    e = lash.Estimator("input-deadzone", 0.01, guess_right=3.0, guess_left=-3.0, reguess=reguess)
+    e = lash.Estimator("input-deadzone", 0.01, guess_right=3.0, guess_left=-3.0, reguess=reguess, preset="thesis")
     e.update_many(v, y)
     return e
 

@@ -89,28 +89,46 @@ EstimateReport AnyEstimator::report() const {
 }
 
 EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> v, std::span<const double> y,
-                            bool keep_trace, const std::function<void(const AnyEstimator&)>& at_end,
-                            std::span<const std::size_t> gap_rows) {
+                            const RunOptions& o) {
   if (v.size() != y.size()) throw std::invalid_argument("v and y differ in length");
   AnyEstimator est(cfg);
   EstimationRun run;
   const std::size_t n = v.size();
-  run.yhat.reserve(n);  // filled in step order below: no zero-filling pass over 2 x n doubles first
-  run.ysim.reserve(n);
+  if (o.keep_outputs) {
+    run.yhat.reserve(n);  // filled in step order below: no zero-filling pass over 2 x n doubles first
+    run.ysim.reserve(n);
+  }
   run.param_names = est.param_names();
   std::vector<double> pv(run.param_names.size());
-  if (keep_trace) run.params.assign(pv.size(), std::vector<double>(n));
-  step_through(est, v, y, 0, n, gap_rows, [&](std::size_t k, const auto& e) {
-    run.yhat.push_back(e.prediction());  // k = run.yhat.size(): step_through goes 0, 1, ..., n - 1
-    run.ysim.push_back(e.simulated());
-    if (keep_trace) {
+  if (o.keep_trace) run.params.assign(pv.size(), std::vector<double>(n));
+  const std::size_t s0 = std::min(o.score_begin, n), s1 = std::min(std::max(o.score_end, s0), n);
+  NrmseAccumulator score;
+  // the score reads y as given (an edited row's own value: the edits live apart from y)
+  step_through(est, v, y, 0, n, o.gap_rows, [&](std::size_t k, const auto& e) {
+    if (o.keep_outputs) {
+      run.yhat.push_back(e.prediction());  // k = run.yhat.size(): step_through goes 0, 1, ..., n - 1
+      run.ysim.push_back(e.simulated());
+    }
+    if (k - s0 < s1 - s0) score.add(y[k], e.simulated());  // s0 <= k < s1
+    if (o.keep_trace) {
       est.param_values(pv);
       for (std::size_t p = 0; p < pv.size(); ++p) run.params[p][k] = pv[p];
     }
-  });
+  }, o.y_edits);
+  run.score = score;
   run.report = est.report();
-  if (at_end) at_end(est);
+  if (o.at_end) o.at_end(est);
   return run;
+}
+
+EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> v, std::span<const double> y,
+                            bool keep_trace, const std::function<void(const AnyEstimator&)>& at_end,
+                            std::span<const std::size_t> gap_rows) {
+  RunOptions o;
+  o.keep_trace = keep_trace;
+  o.at_end = at_end;
+  o.gap_rows = gap_rows;
+  return run_estimator(cfg, v, y, o);
 }
 
 void add_intervals(EstimationRun& run, const EstimatorConfig& cfg, std::span<const double> v,

@@ -182,10 +182,17 @@ EstimatorConfig preset_config(ModelKind model, Preset preset, double dt_s) {
 // The quantiles are exact (the value std::nth_element puts at rank ⌊q·(n − 1)⌋ of a full copy of
 // the sequence), in memory of a few per cent of the record: see Selection and
 // docs/identification.md ("Defaults chosen from the data").
-DataTraits analyse_record(std::span<const double> v, std::span<const double> y, double dt_s) {
+DataTraits analyse_record(std::span<const double> v, std::span<const double> y, double dt_s, YEdits ed) {
   DataTraits d;
   d.dt_s = dt_s;
   const std::size_t n = std::min(v.size(), y.size());
+  // y as the estimators see it: y[i], or the edit's value at an edited row (by bisection; the
+  // passes below walk the edits with a cursor instead)
+  const auto y_at = [&](std::size_t i) {
+    const auto it = std::lower_bound(ed.rows.begin(), ed.rows.end(), i);
+    return it != ed.rows.end() && *it == i ? ed.values[static_cast<std::size_t>(it - ed.rows.begin())] : y[i];
+  };
+  constexpr std::size_t kNoEdit = static_cast<std::size_t>(-1);
   // The five sequences' quantiles (index of the sequence, q)
   constexpr std::array<std::pair<int, double>, 7> kQ{{{0, 0.001}, {0, 0.999}, {1, 0.001}, {1, 0.999},
                                                       {2, 0.5}, {3, 0.9}, {4, 0.9}}};
@@ -205,11 +212,11 @@ DataTraits analyse_record(std::span<const double> v, std::span<const double> y, 
         const double u = static_cast<double>(rng >> 11) * 0x1p-53;
         const std::size_t k = std::min(n - 1, 40 + static_cast<std::size_t>((static_cast<double>(j) + u) * stratum));
         bool ok = true;
-        for (std::size_t i = k - 40; i <= k; ++i) ok = ok && std::isfinite(v[i]) && std::isfinite(y[i]);
+        for (std::size_t i = k - 40; i <= k; ++i) ok = ok && std::isfinite(v[i]) && std::isfinite(y_at(i));
         if (!ok) continue;
         Streams s{dt_s};
         for (std::size_t i = k - 40; i <= k; ++i)
-          s.push(v[i], y[i], [&](int idx, double x) {
+          s.push(v[i], y_at(i), [&](int idx, double x) {
             if (i == k) smp[static_cast<std::size_t>(idx)].push_back(x);
           });
       }
@@ -230,14 +237,21 @@ DataTraits analyse_record(std::span<const double> v, std::span<const double> y, 
   // the pass over the selections `active` (a bit per selection); returns the count of finite pairs
   const auto pass = [&](unsigned active, bool first) {
     std::size_t k = 0;  // finite pairs before the chunk
+    std::size_t e = 0, next_edit = ed.rows.empty() ? kNoEdit : ed.rows[0];
     for (std::size_t r = 0; r < n;) {
       std::size_t m = 0;
-      for (; r < n && m < kChunk; ++r)
-        if (std::isfinite(v[r]) && std::isfinite(y[r])) {
+      for (; r < n && m < kChunk; ++r) {
+        double yr = y[r];
+        if (r == next_edit) [[unlikely]] {
+          yr = ed.values[e++];
+          next_edit = e < ed.rows.size() ? ed.rows[e] : kNoEdit;
+        }
+        if (std::isfinite(v[r]) && std::isfinite(yr)) {
           vb[m] = v[r];
-          yb[kLead + m] = y[r];
+          yb[kLead + m] = yr;
           ++m;
         }
+      }
       const double* yc = yb.data() + kLead;  // yc[j] = the (k + j)-th finite y; yc[-40..-1] the ones before
       // |Δ²y| from finite index 2, |Δ₄₀y|/(40T) from 40, |Δ²y|/T² where y moved the same way twice
       const std::size_t j2 = k >= 2 ? 0 : std::min(m, 2 - k), j40 = k >= 40 ? 0 : std::min(m, 40 - k);
@@ -313,13 +327,19 @@ DataTraits analyse_record(std::span<const double> v, std::span<const double> y, 
     std::size_t off = 0, seen = 0;
     double y_prev = 0.0;
     const std::size_t n_all = n;
+    std::size_t e = 0, next_edit = ed.rows.empty() ? kNoEdit : ed.rows[0];
     for (std::size_t i = 0; i < n_all && off <= off_allowed; ++i) {
-      if (!(std::isfinite(v[i]) && std::isfinite(y[i]))) continue;
+      double yi = y[i];
+      if (i == next_edit) [[unlikely]] {
+        yi = ed.values[e++];
+        next_edit = e < ed.rows.size() ? ed.rows[e] : kNoEdit;
+      }
+      if (!(std::isfinite(v[i]) && std::isfinite(yi))) continue;
       if (seen++ >= 1) {
-        const double s = std::fabs(y[i] - y_prev);
+        const double s = std::fabs(yi - y_prev);
         if (s > 0.0) off += std::fabs(s / q - std::round(s / q)) < 1e-3 ? 0u : 1u;
       }
-      y_prev = y[i];
+      y_prev = yi;
     }
     if (off <= off_allowed) d.quantum = q;
   }
@@ -332,45 +352,55 @@ void tune_to_data(EstimatorConfig& c, const DataTraits& d) {
   with_model(c.model, [&]<class Model>() { Model::tune(c, d); });  // identify/models/
 }
 
-AutoRun estimate_auto(const EstimatorConfig& cfg0, std::span<const double> v, std::span<const double> y_raw,
-                      bool keep_trace, double gate, std::span<const std::size_t> gap_rows) {
+AutoRun estimate_auto(const EstimatorConfig& cfg0, std::span<const double> v, std::span<const double> y,
+                      const AutoOptions& o) {
   AutoRun out;
   // The gate is causal (usable online); over a whole record the sample after a flagged one is also
   // known: when it lies nearer the flagged value than the last accepted one, the output really
-  // stepped there (a square-wave input) and the sample is restored. gate 0 = off: y is used as is.
-  std::vector<double> yc;
-  std::uint64_t flagged = 0;
-  if (gate > 0.0) {
-    yc.assign(y_raw.begin(), y_raw.end());
+  // stepped there (a square-wave input) and the sample is kept. gate 0 = off: y is used as is.
+  // The replaced samples are kept apart from y (YEdits): no copy of the record.
+  std::vector<std::size_t> edit_rows;
+  std::vector<double> edit_values;
+  if (o.gate > 0.0) {
     OutlierGateConfig gc;
-    gc.gate = gate;
+    gc.gate = o.gate;
     OutlierGate gate_y(gc);
-    for (std::size_t k = 0; k < yc.size(); ++k) {
+    for (std::size_t k = 0; k < y.size(); ++k) {
       const std::uint64_t before = gate_y.rejected();
-      yc[k] = gate_y.step(y_raw[k]);
-      if (gate_y.rejected() == before) continue;
-      const double next = k + 1 < yc.size() ? y_raw[k + 1] : yc[k];
-      if (std::fabs(next - y_raw[k]) < std::fabs(next - yc[k])) yc[k] = y_raw[k];
-      else ++flagged;
+      const double g = gate_y.step(y[k]);
+      if (gate_y.rejected() == before) continue;  // accepted: g is y[k]
+      const double next = k + 1 < y.size() ? y[k + 1] : g;
+      if (std::fabs(next - y[k]) < std::fabs(next - g)) continue;  // a true step: y[k] stays
+      edit_rows.push_back(k);
+      edit_values.push_back(g);
     }
   }
-  out.outliers = flagged;
-  const std::span<const double> y = gate > 0.0 ? std::span<const double>(yc) : y_raw;
+  out.outliers = edit_rows.size();
+  const YEdits edits{edit_rows, edit_values};
   out.cfg = cfg0;
   EstimatorConfig& cfg = out.cfg;
   const bool search_r = uses_guesses(cfg.model) && std::isinf(cfg.guess_right);
   const bool search_l = uses_guesses(cfg.model) && std::isinf(cfg.guess_left);
   if (search_r || search_l) {
-    const auto g = search_guesses(cfg, v, y, gap_rows);
+    const auto g = search_guesses(cfg, v, y, o.gap_rows, edits,
+                                  edit_rows.empty() && o.traits && o.traits->dt_s == cfg.dt_s ? o.traits : nullptr);
     if (search_r) cfg.guess_right = g[0];
     if (search_l) cfg.guess_left = g[1];
   }
   // The edges each side's regression points at are read from the same run's final state (no second pass).
-  out.run = run_estimator(cfg, v, y, keep_trace, [&](const AnyEstimator& est) {
+  RunOptions ro;
+  ro.keep_trace = o.keep_trace;
+  ro.keep_outputs = o.keep_outputs;
+  ro.gap_rows = o.gap_rows;
+  ro.y_edits = edits;
+  ro.score_begin = o.score_begin;
+  ro.score_end = o.score_end;
+  ro.at_end = [&](const AnyEstimator& est) {
     if (!uses_guesses(cfg.model)) return;
     out.right.edge = est.raw_edge(Side::right);
     out.left.edge = est.raw_edge(Side::left);
-  }, gap_rows);
+  };
+  out.run = run_estimator(cfg, v, y, ro);
   if (uses_guesses(cfg.model)) {
     out.right.guess = cfg.guess_right;
     out.left.guess = cfg.guess_left;
@@ -382,10 +412,20 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, std::span<const double> v, st
   return out;
 }
 
+AutoRun estimate_auto(const EstimatorConfig& cfg, std::span<const double> v, std::span<const double> y,
+                      bool keep_trace, double gate, std::span<const std::size_t> gap_rows) {
+  AutoOptions o;
+  o.keep_trace = keep_trace;
+  o.gate = gate;
+  o.gap_rows = gap_rows;
+  return estimate_auto(cfg, v, y, o);
+}
+
 std::array<double, 2> search_guesses(const EstimatorConfig& cfg0, std::span<const double> v,
-                                     std::span<const double> y, std::span<const std::size_t> gap_rows) {
+                                     std::span<const double> y, std::span<const std::size_t> gap_rows,
+                                     YEdits edits, const DataTraits* traits) {
   if (!uses_guesses(cfg0.model)) return {kInf, -kInf};
-  const DataTraits d = analyse_record(v, y, cfg0.dt_s);
+  const DataTraits d = traits ? *traits : analyse_record(v, y, cfg0.dt_s, edits);
   const double hi = std::max(d.v_hi, 0.0), lo = std::min(d.v_lo, 0.0);
   const double span = hi - lo;
   std::array<double, 2> g{0.7 * hi, 0.7 * lo};
@@ -395,7 +435,7 @@ std::array<double, 2> search_guesses(const EstimatorConfig& cfg0, std::span<cons
     cfg.guess_right = g[0] > 0.0 ? g[0] : kInf;
     cfg.guess_left = g[1] < 0.0 ? g[1] : -kInf;
     AnyEstimator est(cfg);
-    step_through(est, v, y, 0, v.size(), gap_rows, [](std::size_t, const auto&) {});
+    step_through(est, v, y, 0, v.size(), gap_rows, [](std::size_t, const auto&) {}, edits);
     std::array<double, 2> next = g;
     for (int i = 0; i < 2; ++i) {
       const Side s = i == 0 ? Side::right : Side::left;

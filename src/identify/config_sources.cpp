@@ -66,7 +66,10 @@ EstimateSettings resolve_settings(const SettingsSources& src, double dt_s, std::
   cfg = preset_config(*model, out.preset);
   if (dt_s > 0.0) {
     cfg.dt_s = dt_s;
-    if (out.preset == Preset::lash && !v.empty()) tune_to_data(cfg, analyse_record(v, y, dt_s));
+    if (out.preset == Preset::lash && !v.empty()) {
+      out.traits = analyse_record(v, y, dt_s);
+      tune_to_data(cfg, *out.traits);
+    }
   }
   if (file) {
     TomlTable t(*file, src.config_file);

@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <tuple>
+#include <utility>
 
 #include "lash/io/csv.hpp"
 #include "lash/io/error.hpp"
@@ -20,7 +22,7 @@ double thread_cpu_s() noexcept {
 }
 }  // namespace
 
-double sample_period(std::span<const double> t, const std::string& file, const std::vector<int>& line_of_row,
+double sample_period(std::span<const double> t, const std::string& file, const RowLines& line_of_row,
                      const std::string& t_name) {
   if (t.empty()) throw InputError(file, 0, t_name, "no data rows");
   if (t.size() < 3) throw InputError(file, 0, t_name, "need at least 3 samples");
@@ -41,20 +43,33 @@ EstimatorConfig config_for_record(EstimatorConfig cfg, const EstimationJob& job,
   return cfg;
 }
 
-EstimateResult score_estimate(const EstimateReport& report, double dt_s, const EstimationJob& job,
-                              std::span<const double> t, std::span<const double> y, std::span<const double> ysim,
-                              bool t_increasing) {
+namespace {
+/// The result without its NRMSE: the window [t0, t1] of `job` (t1 < 0: to the last t).
+EstimateResult unscored(const EstimateReport& report, double dt_s, const EstimationJob& job,
+                        std::span<const double> t) {
   EstimateResult r;
   r.report = report;
   r.dt_s = dt_s;
   r.nrmse_t0_s = job.nrmse_t0_s;
   r.nrmse_t1_s = job.nrmse_t1_s < 0 ? (t.empty() ? 0.0 : t.back()) : job.nrmse_t1_s;
+  return r;
+}
+/// Rows [k0, k1) of an increasing t with t0 <= t <= t1, by bisection.
+std::pair<std::size_t, std::size_t> window_rows(std::span<const double> t, double t0, double t1) {
+  const auto k0 = static_cast<std::size_t>(std::lower_bound(t.begin(), t.end(), t0) - t.begin());
+  const auto k1 = static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), t1) - t.begin());
+  return {k0, std::max(k0, k1)};
+}
+}  // namespace
+
+EstimateResult score_estimate(const EstimateReport& report, double dt_s, const EstimationJob& job,
+                              std::span<const double> t, std::span<const double> y, std::span<const double> ysim,
+                              bool t_increasing) {
+  EstimateResult r = unscored(report, dt_s, job, t);
   if (t_increasing) {
     const std::size_t n = std::min({t.size(), y.size(), ysim.size()});
-    const auto t_n = t.first(n);
-    const auto k0 = static_cast<std::size_t>(std::lower_bound(t_n.begin(), t_n.end(), r.nrmse_t0_s) - t_n.begin());
-    const auto k1 = static_cast<std::size_t>(std::upper_bound(t_n.begin(), t_n.end(), r.nrmse_t1_s) - t_n.begin());
-    r.nrmse = nrmse(y.subspan(k0, k1 > k0 ? k1 - k0 : 0), ysim.subspan(k0, k1 > k0 ? k1 - k0 : 0));
+    const auto [k0, k1] = window_rows(t.first(n), r.nrmse_t0_s, r.nrmse_t1_s);
+    r.nrmse = nrmse(y.subspan(k0, k1 - k0), ysim.subspan(k0, k1 - k0));
   } else {
     r.nrmse = nrmse(t, y, ysim, r.nrmse_t0_s, r.nrmse_t1_s);
   }
@@ -76,16 +91,27 @@ ArrayEstimate estimate_arrays(const SettingsSources& src, std::span<const double
   ArrayEstimate out;
   out.sampling = o.sampling ? *o.sampling : analyse_sampling(t);
   const Sampling& smp = out.sampling;
+  const auto t_start = std::chrono::steady_clock::now();
+  const double cpu_start = thread_cpu_s();
   const EstimateSettings set = resolve_settings(src, smp.dt, v, y);
   out.preset = set.preset;
   out.job = set.job;
-  const auto t_start = std::chrono::steady_clock::now();
-  const double cpu_start = thread_cpu_s();
-  out.run = estimate_auto(set.cfg, v, y, o.trace, o.outlier_gate, smp.gap_rows);
+  AutoOptions ao;
+  ao.keep_trace = o.trace;
+  ao.keep_outputs = o.outputs || o.trace;
+  ao.gate = o.outlier_gate;
+  ao.gap_rows = smp.gap_rows;
+  ao.traits = set.traits ? &*set.traits : nullptr;  // the guess search needs the same quantiles
+  // the NRMSE window's rows: its sum is taken during the final run (no stored y_sim needed)
+  EstimateResult scored = unscored({}, smp.dt, set.job, t);
+  std::tie(ao.score_begin, ao.score_end) = window_rows(t, scored.nrmse_t0_s, scored.nrmse_t1_s);
+  out.run = estimate_auto(set.cfg, v, y, ao);
   out.estimator_cpu_s = thread_cpu_s() - cpu_start;
   out.estimator_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   if (o.intervals) add_intervals(out.run.run, out.run.cfg, v, y, smp.gap_rows);
-  out.result = score_estimate(out.run.run.report, smp.dt, set.job, t, y, out.run.run.ysim, true);
+  scored.report = out.run.run.report;
+  scored.nrmse = out.run.run.score.value();
+  out.result = std::move(scored);
   out.fit = report_fit(out.result);  // with what the reader found: skipped rows, gaps, median step of t
   out.fit.rows_skipped = o.rows_skipped;
   out.fit.first_skipped_line = o.first_skipped_line;

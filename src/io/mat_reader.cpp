@@ -193,8 +193,7 @@ Table read_mat(const std::filesystem::path& path, const std::vector<std::string>
   if (n == 0) throw InputError(file, 0, variables.front(), "every named variable is a scalar; at least one vector is needed");
   for (std::size_t i = 0; i < variables.size(); ++i)
     if (scalar[i]) t.cols[i].assign(n, t.cols[i][0]);
-  t.line_of_row.resize(n);
-  for (std::size_t k = 0; k < n; ++k) t.line_of_row[k] = static_cast<int>(k + 1);
+  t.line_of_row.assign_consecutive(n, 1);
   return t;
 }
 
@@ -235,8 +234,7 @@ Table read_mat_table(const std::filesystem::path& path, const TableOptions& opti
     t.names.push_back(c);
     t.cols.emplace_back(m.begin() + static_cast<std::ptrdiff_t>(j * n), m.begin() + static_cast<std::ptrdiff_t>((j + 1) * n));
   }
-  t.line_of_row.resize(n);
-  for (std::size_t i = 0; i < n; ++i) t.line_of_row[i] = static_cast<int>(i + 1);
+  t.line_of_row.assign_consecutive(n, 1);
   return t;
 }
 

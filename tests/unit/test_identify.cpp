@@ -16,6 +16,7 @@
 #include "lash/blocks.hpp"
 #include "lash/identify/any_estimator.hpp"
 #include "lash/identify/auto.hpp"
+#include "lash/identify/auto_gate.hpp"
 #include "lash/identify/preprocess.hpp"
 #include "lash/identify/rls.hpp"
 #include "lash/plant/plant.hpp"
@@ -798,6 +799,60 @@ TEST(AnalyseRecord, QuantilesEqualFullCopiesToTheBit) {
   for (auto& x : vr) x = rng.gaussian() * 100.0;
   expect_same_traits(analyse_record(vr, y, 0.002), analyse_reference(vr, y, 0.002), "white input");
   EXPECT_GT(analyse_record(v, yq, 0.001).quantum, 0.0);  // the encoder step is found
+}
+
+// The outlier gate's replacements are kept apart from y (YEdits, no copy of the record): the run
+// must be the one on a gated copy made by hand with the rule auto.hpp documents (gate; a flagged
+// sample stays when the next one lies nearer it than the replacement), and analyse_record with the
+// edits must equal the reference on that copy; the NRMSE score reads the record's own y.
+TEST(EstimateAuto, OutlierEditsEqualAGatedCopy) {
+  const SimulationTrace tr = eq34_sine(120, 4, 5);  // 24000 rows: the quantiles use their bracket
+  std::vector<double> v = tr.col("v"), y = tr.col("y");
+  for (std::size_t k = 700; k < y.size(); k += 1777) y[k] += (k % 2 ? 400.0 : -400.0);  // isolated spikes
+  for (std::size_t k = 0; k < v.size(); k += 100) v[k] = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> yc(y);
+  OutlierGate g;
+  std::size_t flagged = 0;
+  for (std::size_t k = 0; k < y.size(); ++k) {
+    const std::uint64_t before = g.rejected();
+    yc[k] = g.step(y[k]);
+    if (g.rejected() == before) continue;
+    const double next = k + 1 < y.size() ? y[k + 1] : yc[k];
+    if (std::fabs(next - y[k]) < std::fabs(next - yc[k])) yc[k] = y[k];
+    else ++flagged;
+  }
+  ASSERT_GT(flagged, 5u);
+  EstimatorConfig c = preset_config(ModelKind::deadzone_deadband, Preset::lash, 0.005);
+  tune_to_data(c, analyse_record(v, y, 0.005));
+  AutoOptions o;
+  o.score_begin = 1500;
+  o.score_end = y.size();
+  const AutoRun edited = estimate_auto(c, v, y, o);
+  o.gate = 0.0;
+  const AutoRun copied = estimate_auto(c, v, yc, o);
+  EXPECT_EQ(edited.outliers, flagged);
+  EXPECT_EQ(edited.cfg.guess_right, copied.cfg.guess_right);
+  EXPECT_EQ(edited.cfg.guess_left, copied.cfg.guess_left);
+  ASSERT_EQ(edited.run.ysim.size(), y.size());
+  for (std::size_t k = 0; k < y.size(); ++k) {
+    ASSERT_EQ(std::bit_cast<std::uint64_t>(edited.run.yhat[k]), std::bit_cast<std::uint64_t>(copied.run.yhat[k])) << k;
+    ASSERT_EQ(std::bit_cast<std::uint64_t>(edited.run.ysim[k]), std::bit_cast<std::uint64_t>(copied.run.ysim[k])) << k;
+  }
+  // the score: the record's y (spikes and all) against y_sim over the rows asked for
+  NrmseAccumulator acc;
+  for (std::size_t k = 1500; k < y.size(); ++k) acc.add(y[k], edited.run.ysim[k]);
+  EXPECT_EQ(edited.run.score.value(), acc.value());
+  EXPECT_EQ(edited.run.score.value(), nrmse(std::span(y).subspan(1500), std::span(edited.run.ysim).subspan(1500)));
+  // analyse_record through the edits is analyse_record of the copy (the search's first pass)
+  std::vector<std::size_t> rows;
+  std::vector<double> vals;
+  for (std::size_t k = 0; k < y.size(); ++k)
+    if (std::bit_cast<std::uint64_t>(yc[k]) != std::bit_cast<std::uint64_t>(y[k])) {
+      rows.push_back(k);
+      vals.push_back(yc[k]);
+    }
+  EXPECT_EQ(rows.size(), flagged);
+  expect_same_traits(analyse_record(v, y, 0.005, YEdits{rows, vals}), analyse_reference(v, yc, 0.005), "edited");
 }
 
 }  // namespace

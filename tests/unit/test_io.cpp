@@ -241,6 +241,24 @@ TEST(Table, ChoicesAreCheckedAndOnlyChosenCellsParsed) {
   fs::remove(p);
 }
 
+TEST(Table, LineOfEachRowAcrossCommentsBlankAndSkippedLines) {
+  // lines: 1 header, 2-3 rows, 4 comment, 5 blank, 6-7 rows, 8 skipped (nan), 9 row
+  const auto p = tmpfile("lines.csv", "t,v,y\n0,1,2\n1,1,2\n# note\n\n2,1,2\n3,1,2\n4,nan,2\n5,1,2\n");
+  TableOptions o;
+  o.columns = {"t", "v", "y"};
+  const Table t = read_table(p, o);
+  ASSERT_EQ(t.rows(), 5u);
+  EXPECT_EQ(t.line_of_row.to_vector(), (std::vector<int>{2, 3, 6, 7, 9}));
+  EXPECT_EQ(t.line_of_row[3], 7);
+  EXPECT_EQ(t.line_of_row.size(), 5u);
+  EXPECT_EQ(t.line_of_row.runs(), 3u);  // 2-3, 6-7, 9: memory by breaks, not by rows
+  RowLines m;
+  m.assign_consecutive(1000000, 1);  // a MAT file's element indices
+  EXPECT_EQ(m[999999], 1000000);
+  EXPECT_EQ(m.runs(), 1u);
+  fs::remove(p);
+}
+
 TEST(Table, NonFiniteRowsAreSkippedAndCountedUnlessStrict) {
   const auto p = tmpfile("nan.csv", "t,v,y\n0,1,2\n0.1,nan,3\n0.2,2,\n0.3,inf,1\n0.4,5,NaN\n0.5,6,7\n");
   TableOptions o;
@@ -249,7 +267,7 @@ TEST(Table, NonFiniteRowsAreSkippedAndCountedUnlessStrict) {
   EXPECT_EQ(t.skipped_rows, 4u);
   EXPECT_EQ(t.first_skipped_line, 3);
   EXPECT_EQ(t.cols[0], (std::vector<double>{0, 0.5}));
-  EXPECT_EQ(t.line_of_row, (std::vector<int>{2, 7}));
+  EXPECT_EQ(t.line_of_row.to_vector(), (std::vector<int>{2, 7}));
   o.strict = true;
   try {
     read_table(p, o);

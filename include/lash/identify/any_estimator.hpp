@@ -129,23 +129,46 @@ class AnyEstimator {
   std::uint64_t samples_ = 0;
 };
 
+/// Samples of y replaced before an estimator sees them (the outlier gate's, auto_gate.hpp):
+/// row rows[i] reads values[i] instead of y[rows[i]]; rows ascending. The record itself stays
+/// as it is (memory: two numbers per replaced sample, not a copy of y).
+struct YEdits {
+  std::span<const std::size_t> rows;
+  std::span<const double> values;
+};
+
 /// Steps `est` through samples [begin, end) of v, y, calling restart() before every row listed
 /// in `gap_rows` (ascending row indices where a gap ends, as Record::gap_rows() / Table::gap_rows;
 /// a gap row outside the range is ignored), and `each(k, e)` after the step of sample k, where `e`
 /// is the concrete estimator (LinearEstimator, ...): the variant is dispatched once per call, not
-/// per sample. The one run loop of every whole-record estimation (run_estimator, search_guesses,
-/// the intervals' sections).
+/// per sample. `edits`: samples of y read from elsewhere (YEdits). The one run loop of every
+/// whole-record estimation (run_estimator, search_guesses, the intervals' sections).
 template <class Each>
 void step_through(AnyEstimator& est, std::span<const double> v, std::span<const double> y, std::size_t begin,
-                  std::size_t end, std::span<const std::size_t> gap_rows, Each&& each) {
+                  std::size_t end, std::span<const std::size_t> gap_rows, Each&& each, YEdits edits = {}) {
   est.visit_steps(end - begin, [&](auto& e) {
+    constexpr std::size_t kNone = static_cast<std::size_t>(-1);
     auto gap = std::lower_bound(gap_rows.begin(), gap_rows.end(), begin);
+    auto edit = std::lower_bound(edits.rows.begin(), edits.rows.end(), begin);
+    std::size_t next_gap = gap != gap_rows.end() ? *gap : kNone;
+    std::size_t next_edit = edit != edits.rows.end() ? *edit : kNone;
+    std::size_t next = std::min(next_gap, next_edit);  // one comparison per sample for both
     for (std::size_t k = begin; k < end; ++k) {
-      if (gap != gap_rows.end() && *gap == k) {
-        if (k > begin) e.restart();  // at `begin` the history is already empty (new or reset estimator)
-        ++gap;
+      double yk = y[k];
+      if (k == next) [[unlikely]] {
+        if (k == next_gap) {
+          if (k > begin) e.restart();  // at `begin` the history is already empty (new or reset estimator)
+          ++gap;
+          next_gap = gap != gap_rows.end() ? *gap : kNone;
+        }
+        if (k == next_edit) {
+          yk = edits.values[static_cast<std::size_t>(edit - edits.rows.begin())];
+          ++edit;
+          next_edit = edit != edits.rows.end() ? *edit : kNone;
+        }
+        next = std::min(next_gap, next_edit);
       }
-      e.step(v[k], y[k]);
+      e.step(v[k], yk);
       each(k, std::as_const(e));
     }
   });
@@ -154,11 +177,28 @@ void step_through(AnyEstimator& est, std::span<const double> v, std::span<const 
 /// Result of running an estimator over a whole record.
 struct EstimationRun {
   EstimateReport report;
-  std::vector<double> yhat, ysim;                 ///< per sample
+  std::vector<double> yhat, ysim;                 ///< per sample (only with RunOptions::keep_outputs)
   std::vector<std::string> param_names;
   std::vector<std::vector<double>> params;        ///< params[p][k] (only if keep_trace)
+  /// NRMSE of y_sim against y (as given, before any YEdits) over RunOptions' score rows, summed
+  /// during the run in row order (the same bits as metrics nrmse() over the stored outputs).
+  NrmseAccumulator score;
 };
 
+struct RunOptions {
+  bool keep_trace = false;    ///< store every parameter per step (EstimationRun::params)
+  bool keep_outputs = true;   ///< store ŷ and y_sim per step (EstimationRun::yhat, ysim)
+  /// `at_end`, when given, is called with the estimator after the last sample (to read more of
+  /// its final state without a second pass over the record).
+  std::function<void(const AnyEstimator&)> at_end;
+  std::span<const std::size_t> gap_rows;  ///< where t jumps: the estimator restarts there (step_through)
+  YEdits y_edits;             ///< samples of y the estimator reads from elsewhere (the outlier gate's)
+  std::size_t score_begin = 0, score_end = 0;  ///< rows [begin, end) of EstimationRun::score
+};
+
+/// Steps `cfg`'s estimator through v, y (same length), as RunOptions say. Not real-time safe.
+EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> v, std::span<const double> y,
+                            const RunOptions& options);
 /// Steps `cfg`'s estimator through v, y (same length). keep_trace stores the parameters per step.
 /// `at_end`, when given, is called with the estimator after the last sample (to read more of its
 /// final state without a second pass over the record). `gap_rows`: where the record's timestamps

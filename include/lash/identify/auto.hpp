@@ -50,8 +50,9 @@ struct DataTraits {
   /// Smallest step of y (encoder resolution) [y unit]; 0 when y is not visibly quantised.
   double quantum = 0.0;
 };
-/// Not real-time safe. Non-finite samples are ignored.
-DataTraits analyse_record(std::span<const double> v, std::span<const double> y, double dt_s);
+/// Not real-time safe. Non-finite samples are ignored. `y_edits`: samples of y read from
+/// elsewhere (the outlier gate's replacements, any_estimator.hpp YEdits).
+DataTraits analyse_record(std::span<const double> v, std::span<const double> y, double dt_s, YEdits y_edits = {});
 
 /// Sets the data-dependent settings of a `Preset::lash` config (docs/identification.md).
 void tune_to_data(EstimatorConfig& cfg, const DataTraits& d);
@@ -77,20 +78,40 @@ struct AutoRun {
   std::uint64_t outliers = 0;  ///< samples of y the outlier gate replaced (auto_gate.hpp)
 };
 
+struct AutoOptions {
+  bool keep_trace = false;    ///< every parameter per step (RunOptions::keep_trace)
+  bool keep_outputs = true;   ///< ŷ and y_sim per step (RunOptions::keep_outputs)
+  double gate = 12.0;         ///< the outlier gate's threshold [innovation scales] (0 = off)
+  std::span<const std::size_t> gap_rows;  ///< where t jumps (Record::gap_rows())
+  /// Rows [begin, end) whose NRMSE of the final run's y_sim against y (as given, not gated) is
+  /// summed into run.score.
+  std::size_t score_begin = 0, score_end = 0;
+  /// analyse_record(v, y, cfg.dt_s) of this y, when the caller has it (resolve_settings took it to
+  /// tune the settings): the guess search reuses it when the gate replaced no sample (the gated y
+  /// is then this y, bit for bit) instead of taking the same quantiles again.
+  const DataTraits* traits = nullptr;
+};
+
 /// Runs `cfg`'s estimator over v, y. For input-deadzone and deadzone-deadband, a side whose
 /// guess is infinite is searched: pass 0 uses c* = 0.7·(v quantile of that side); each pass sets
 /// c* = ĉ + max(margin, 0.15·(v_extreme − ĉ)) from the side's identified edge ĉ, or moves c*
 /// halfway out when ĉ lies beyond c* (inside-the-deadzone guess), until c* moves less than 1 %
 /// of the input span (at most 5 passes). Not real-time safe.
-/// y first passes the outlier gate (auto_gate.hpp) with threshold `gate` (0 = off).
-/// `gap_rows`: where the record's timestamps jump (Record::gap_rows()); every run restarts its
-/// estimator's regressors there (AnyEstimator::restart).
+/// y first passes the outlier gate (auto_gate.hpp) with threshold `options.gate`; the replaced
+/// samples are kept apart (YEdits: O(replaced) memory, no copy of y). Every run restarts its
+/// estimator's regressors at `options.gap_rows` (AnyEstimator::restart).
+AutoRun estimate_auto(const EstimatorConfig& cfg, std::span<const double> v, std::span<const double> y,
+                      const AutoOptions& options);
+/// The same with the options of before: keep_trace, gate, gap_rows (outputs kept, no score).
 AutoRun estimate_auto(const EstimatorConfig& cfg, std::span<const double> v, std::span<const double> y,
                       bool keep_trace = false, double gate = 12.0, std::span<const std::size_t> gap_rows = {});
 
 /// The switching guesses estimate_auto would use on this record ({c_r*, c_l*}); for the sweep,
 /// which runs its estimator online on a rig whose open-loop record it can take first.
+/// `y_edits`: samples of y read from elsewhere (YEdits); `traits`: analyse_record of (v, y with
+/// the edits), when the caller has it.
 std::array<double, 2> search_guesses(const EstimatorConfig& cfg, std::span<const double> v,
-                                     std::span<const double> y, std::span<const std::size_t> gap_rows = {});
+                                     std::span<const double> y, std::span<const std::size_t> gap_rows = {},
+                                     YEdits y_edits = {}, const DataTraits* traits = nullptr);
 
 }  // namespace lash

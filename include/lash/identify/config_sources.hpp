@@ -33,6 +33,9 @@ struct EstimateSettings {
   EstimatorConfig cfg;  ///< validated; fit_start_s = job.nrmse_t0_s (the verdict's fit window is the reported one)
   EstimationJob job;
   Preset preset = Preset::lash;
+  /// What the record said (analyse_record), when the settings were tuned to it (preset lash with
+  /// a record); estimate_arrays hands it on to the guess search (AutoOptions::traits).
+  std::optional<DataTraits> traits;
 };
 
 /// Resolves and validates the settings. dt_s: the record's sample period [s] (<= 0: not known yet,

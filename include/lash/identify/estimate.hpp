@@ -28,7 +28,7 @@ struct EstimateResult {
 
 /// Checks a time column (at least 3 samples, strictly increasing) and returns its mean step [s].
 /// Errors name `file`, the line of the row (from `line_of_row`, when given) and the column `t_name`.
-double sample_period(std::span<const double> t, const std::string& file = "", const std::vector<int>& line_of_row = {},
+double sample_period(std::span<const double> t, const std::string& file = "", const RowLines& line_of_row = {},
                      const std::string& t_name = "t");
 
 /// The estimator settings for one record: `cfg` with the record's sample period `dt_s` [s] and
@@ -49,7 +49,10 @@ ReportFit report_fit(const EstimateResult& result) noexcept;
 std::string to_json(const EstimateResult& result);
 
 struct ArrayEstimateOptions {
-  bool trace = false;          ///< keep every parameter per sample (run.run.params)
+  bool trace = false;          ///< keep every parameter per sample (run.run.params), and ŷ, y_sim
+  /// keep ŷ and y_sim per sample (run.run.yhat, ysim; 16 B per sample). The NRMSE is summed
+  /// during the final run either way (EstimationRun::score).
+  bool outputs = true;
   double outlier_gate = 12.0;  ///< estimate_auto's outlier gate [innovation scales] (0 = off)
   bool intervals = true;       ///< the 95 % intervals (add_intervals: one more estimator pass over sections)
   /// The sampling of t when the caller has it already (a file's reader analysed it): else analysed here.
@@ -67,8 +70,11 @@ struct ArrayEstimate {
   Preset preset = Preset::lash;
   EstimationJob job;      ///< the job part of the resolved settings (columns, NRMSE window)
   ReportFit fit;          ///< the fit part of the report (NRMSE, window, skipped rows, gaps, median step)
-  double estimator_s = 0.0;  ///< wall time of estimate_auto alone [s] (`lash estimate --timing`)
-  double estimator_cpu_s = 0.0;  ///< CPU time of the calling thread in estimate_auto [s] (`--timing`)
+  /// Wall time of the estimator with its defaults [s] (`lash estimate --timing`): the settings
+  /// chosen from the data (resolve_settings with the record: analyse_record), the outlier gate,
+  /// the guess search and the final run (estimate_auto); not the intervals, nor the reading.
+  double estimator_s = 0.0;
+  double estimator_cpu_s = 0.0;  ///< CPU time of the calling thread in the same [s] (`--timing`)
   std::string json;       ///< what `lash estimate --json` prints (estimate_auto_json)
 };
 

@@ -20,6 +20,7 @@
 /// - any other text in a chosen cell is an InputError naming file:line:column.
 /// Ingest streams the file in 1 MiB blocks, parses with std::from_chars straight into the
 /// columns (reserved from the file size) and allocates nothing per row.
+#include <algorithm>
 #include <cstddef>
 #include <filesystem>
 #include <string>
@@ -29,12 +30,58 @@
 
 namespace lash {
 
+/// The file line of each row of a table, kept as runs of rows on consecutive lines (a file
+/// without comments, blank or skipped lines is one run): memory grows with the breaks, not with
+/// the rows (a 10^7-row CSV needs a few bytes where a line number per row took 40 MB).
+class RowLines {
+ public:
+  /// Appends the line of the next row.
+  void push_back(int line) {
+    if (n_ == 0 || line != last_ + 1) runs_.push_back({n_, line});
+    last_ = line;
+    ++n_;
+  }
+  /// Rows 0 … n − 1 on lines first, first + 1, … (a MAT file's element indices).
+  void assign_consecutive(std::size_t n, int first) {
+    runs_.clear();
+    n_ = n;
+    if (n) runs_.push_back({0, first});
+    last_ = first + static_cast<int>(n) - 1;
+  }
+  /// The line of row `row` (< size()); O(log breaks).
+  int operator[](std::size_t row) const noexcept {
+    auto it = std::upper_bound(runs_.begin(), runs_.end(), row,
+                               [](std::size_t r, const Run& x) { return r < x.row; });
+    --it;
+    return it->line + static_cast<int>(row - it->row);
+  }
+  std::size_t size() const noexcept { return n_; }
+  bool empty() const noexcept { return n_ == 0; }
+  int front() const noexcept { return runs_.front().line; }
+  int back() const noexcept { return last_; }
+  std::size_t runs() const noexcept { return runs_.size(); }
+  std::vector<int> to_vector() const {
+    std::vector<int> v(n_);
+    for (std::size_t i = 0; i < n_; ++i) v[i] = (*this)[i];
+    return v;
+  }
+
+ private:
+  struct Run {
+    std::size_t row;  ///< first row of the run
+    int line;         ///< its line; row + i is on line + i until the next run
+  };
+  std::vector<Run> runs_;
+  std::size_t n_ = 0;
+  int last_ = 0;
+};
+
 /// Named numeric columns of one length, with where each row came from.
 struct Table {
   std::string file;                       ///< where it came from (for messages)
   std::vector<std::string> names;         ///< column names, in file order or in the order chosen
   std::vector<std::vector<double>> cols;  ///< cols[c][row]
-  std::vector<int> line_of_row;           ///< 1-based file line of each row (MAT: element index)
+  RowLines line_of_row;                   ///< 1-based file line of each row (MAT: element index)
   std::size_t skipped_rows = 0;           ///< rows dropped for a non-finite chosen cell
   int first_skipped_line = 0;             ///< line of the first such row (0: none)
   std::vector<std::size_t> gap_rows;      ///< rows i where a gap ends (mark_gaps): t[i] − t[i−1] is a gap

@@ -63,6 +63,9 @@ class Plant {
   template <std::size_t I>
   static double step_kind(Block& b, double x, Side side) noexcept {
     auto* blk = std::get_if<I>(&b);
+    // fixed_step_for chose this step for exactly these kinds, and a block never changes its kind
+    // (blocks() is const): no check of the variant's index on the sample path
+    if (!blk) __builtin_unreachable();
     if constexpr (I == 0) return blk->step(x);
     else return blk->step(x, side);
   }
