@@ -55,21 +55,32 @@ PerSide<SideIntervals> batch_means_intervals(const EstimatorConfig& cfg, std::sp
                                              std::span<const double> y, const PerSide<SideParams>& estimate,
                                              const IntervalSettings& s) {
   if (v.size() != y.size()) throw std::invalid_argument("v and y differ in length");
-  PerSide<SideIntervals> out;
   const std::size_t n = v.size(), B = s.sections;
-  if (B < 2 || n / B < 2) return out;
+  if (B < 2 || n / B < 2) return {};
   const std::size_t len = n / B;
+  std::vector<PerSide<SideParams>> secs;
+  secs.reserve(B);
+  AnyEstimator est(cfg);
+  for (std::size_t b = 0; b < B; ++b) {
+    est.reset();
+    step_through(est, v, y, b * len, (b + 1) * len, s.gap_rows, [](std::size_t, const auto&) {});
+    secs.push_back({est.params(Side::right), est.params(Side::left)});
+  }
+  return section_intervals(cfg, secs, len, n, estimate, s.min_sections);
+}
+
+PerSide<SideIntervals> section_intervals(const EstimatorConfig& cfg, std::span<const PerSide<SideParams>> sections,
+                                         std::size_t len, std::size_t n, const PerSide<SideParams>& estimate,
+                                         std::size_t min_sections) {
+  PerSide<SideIntervals> out;
   // per side, per parameter: the section estimates of identified sides
   struct Samples {
     std::vector<double> a1, b1, c, d, K, tau;
   };
   PerSide<Samples> sm;
-  AnyEstimator est(cfg);
-  for (std::size_t b = 0; b < B; ++b) {
-    est.reset();
-    step_through(est, v, y, b * len, (b + 1) * len, s.gap_rows, [](std::size_t, const auto&) {});
+  for (const PerSide<SideParams>& sec : sections) {
     for (Side side : {Side::right, Side::left}) {
-      const SideParams p = est.params(side);
+      const SideParams& p = sec[side];
       if (!p.identified) continue;
       Samples& q = sm[side];
       q.a1.push_back(p.a1);
@@ -86,7 +97,7 @@ PerSide<SideIntervals> batch_means_intervals(const EstimatorConfig& cfg, std::sp
     const SideParams& e = estimate[side];
     const Samples& q = sm[side];
     SideIntervals& r = out[side];
-    const std::size_t m = s.min_sections;
+    const std::size_t m = min_sections;
     r.a1 = around(e.a1, q.a1, scale, m);
     r.b1 = around(e.b1, q.b1, scale, m);
     r.c = around(e.c, q.c, scale, m);
