@@ -287,7 +287,8 @@ class Pipeline {
     last_snapshot_total_ = trimmed_ + n;
     const double t_from = last_period_t_;
     last_period_t_ = t;
-    if (online_ && status != "final" && online_->ready()) {
+    const bool online_period = online_ && status != "final" && online_->ready();
+    if (online_period) {
       // the persistent estimator's state now: O(1) whatever the window (online.hpp)
       auto snap = online_->snapshot(t_from, t);
       p.json = std::move(snap->json);
@@ -333,7 +334,9 @@ class Pipeline {
     }
     // online: the final estimate (over the window, from scratch) is another estimator than the
     // periods'; the detector follows the periods' only
-    if (!p.params.empty() && !(online_ && status == "final")) detector_.update(t, p.params, pending_events_);
+    // online: the detector follows the persistent estimator's periods only (not the window
+    // estimates of the first init_s seconds nor the final one: other estimators, other levels)
+    if (!p.params.empty() && !(online_ && !online_period)) detector_.update(t, p.params, pending_events_);
     p.events = std::move(pending_events_);
     pending_events_.clear();
     for (const Event& e : p.events)
