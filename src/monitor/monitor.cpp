@@ -293,7 +293,8 @@ class Pipeline {
       auto snap = online_->snapshot(t_from, t);
       p.json = std::move(snap->json);
       p.params = monitored_params(snap->report);
-      p.samples = online_->samples();
+      p.samples = trimmed_ + n;  // the samples received up to T (the estimator has stepped all but
+                                 // the last, held for the outlier gate's look-ahead: the JSON's samples)
     } else if (m >= 3) {
       // the window's estimate from scratch: mode window, the final estimate, and (online) the
       // periods of the first online.init_s seconds, before the settings are chosen
