@@ -9,13 +9,14 @@ the same run of this script; times are CPU time (user + system) of the child fro
 the other loads of a shared machine do not enter; peak memory is the child's ru_maxrss.
 
 Printed per log: frames, `lash can decode --dbc DBC LOG > /dev/null` frames/s,
-`lash monitor LOG ...` frames/s at --every 1 and --every 60 (the default 120 s window), their
-ratios to decode (decode CPU time / monitor CPU time: above 1, the monitor reads the log faster
+`lash monitor LOG ...` frames/s at --every 1 (the default: with the default estimator, `online`,
+these are the monitor's defaults) and --every 60, with each --estimate mode asked (default: online;
+`window` re-estimates the 120 s window every period), their ratios to decode (decode CPU time / monitor CPU time: above 1, the monitor reads the log faster
 than decode prints it), and the peak RSS of each; then the RSS ratio of the longest log to the
 shortest for each command (both stream the log: about 1).
 
 usage: bench/monitor_bench.py [--lash build/bin/lash] [--log master_bus.log] [--minutes 10]
-                              [--scales 1,10] [--every 1,60] [--no-decode]
+                              [--scales 1,10] [--every 1,60] [--estimate online,window] [--no-decode]
        e.g. --minutes 60 --scales 1,24 --every 60: 1 h and 24 h of the bench's bus
        (without --log it runs `lash hil run` of the valve drift scenario first, 40 s)
 """
@@ -33,6 +34,8 @@ ap.add_argument("--log", help="a master_bus.log of the bench (default: a fresh l
 ap.add_argument("--minutes", type=float, default=10.0, help="length of the 1x log [min]")
 ap.add_argument("--scales", default="1,10", help="lengths of the logs in units of --minutes, comma-separated")
 ap.add_argument("--every", default="1,60", help="--every values of the monitor runs [s], comma-separated")
+ap.add_argument("--estimate", default="online", help="--estimate modes of the monitor runs, comma-separated")
+ap.add_argument("--floor", type=float, default=2e6, help="the frames/s the defaults must reach (issue 25)")
 ap.add_argument("--no-decode", action="store_true", help="skip lash can decode")
 a = ap.parse_args()
 
@@ -88,6 +91,7 @@ def run(cmd):
 
 rss = {}
 everys = a.every.split(",")
+modes = a.estimate.split(",")
 scales = [int(x) for x in a.scales.split(",")]
 copies = max(1, round(a.minutes * 60 / span))
 for scale in scales:
@@ -99,13 +103,17 @@ for scale in scales:
         rss[(scale, "decode")] = m_dec
         print(f"    lash can decode          {frames / t_dec:12.0f} frames/s  ({t_dec:7.2f} s CPU)  "
               f"peak RSS {m_dec:7.1f} MiB")
-    for every in everys:
-        t_mon, m_mon = run([a.lash, "monitor", path, *MON, "--every", every])
-        rss[(scale, every)] = m_mon
-        print(f"    lash monitor --every {every:2s}  {frames / t_mon:12.0f} frames/s  ({t_mon:7.2f} s CPU)  "
-              f"peak RSS {m_mon:7.1f} MiB" + ("" if a.no_decode else f"  ratio to decode {t_dec / t_mon:.3f}"))
+    for mode in modes:
+        for every in everys:
+            t_mon, m_mon = run([a.lash, "monitor", path, *MON, "--estimate", mode, "--every", every])
+            rss[(scale, (mode, every))] = m_mon
+            default = mode == "online" and float(every) == 1.0
+            print(f"    lash monitor --estimate {mode:6s} --every {every:2s}{' (defaults)' if default else '           '}"
+                  f"{frames / t_mon:12.0f} frames/s  ({t_mon:7.2f} s CPU)  peak RSS {m_mon:7.1f} MiB"
+                  + ("" if a.no_decode else f"  ratio to decode {t_dec / t_mon:.3f}")
+                  + (f"  {frames / t_mon / a.floor:.2f} x the floor {a.floor:.3g}" if default else ""))
     os.remove(path)
 lo, hi = scales[0], scales[-1]
-for every in ([] if a.no_decode else ["decode"]) + everys:
-    what = "lash can decode" if every == "decode" else f"monitor --every {every}"
-    print(f"{what}: peak RSS {hi}x / {lo}x = {rss[(hi, every)] / rss[(lo, every)]:.3f}")
+for key in ([] if a.no_decode else ["decode"]) + [(m, e) for m in modes for e in everys]:
+    what = "lash can decode" if key == "decode" else f"monitor --estimate {key[0]} --every {key[1]}"
+    print(f"{what}: peak RSS {hi}x / {lo}x = {rss[(hi, key)] / rss[(lo, key)]:.3f}")

@@ -29,6 +29,8 @@ struct MonitorOptions {
   std::string report;
   std::string report_png;
   bool quiet = false;
+  std::string mode = "online";
+  bool no_reguess = false;
   ConsoleArgs console;
 };
 
@@ -42,8 +44,8 @@ void status_line(const monitor::Period& p, const monitor::MonitorCounts& c, doub
     if (v.identified && std::isfinite(v.lo)) line += fmt::format("[{},{}]", num(v.lo), num(v.hi));
     line += " ";
   }
-  line += fmt::format("| {:.0f} samples/s, {} dropped, {} events", wall_s > 0 ? double(c.samples) / wall_s : 0.0,
-                      c.dropped(), c.events);
+  line += fmt::format("| {:.0f} samples/s, {} dropped, {} events, {} re-guesses",
+                      wall_s > 0 ? double(c.samples) / wall_s : 0.0, c.dropped(), c.events, c.reguesses);
   std::fputs(line.c_str(), stderr);
   std::fflush(stderr);
 }
@@ -53,11 +55,11 @@ void print_summary(const monitor::MonitorResult& r) {
   fmt::print(stderr,
              "lash monitor: {} frames, {} samples over {} s, {} periods, {} events{}\n"
              "lash monitor: dropped {}: garbage {}, bad_dlc {}, out_of_range {}, time_back {}, bus {}; "
-             "counter_jumps {}, stale {}, gaps {}, restarts {}; {:.3g} frames/s\n",
+             "counter_jumps {}, stale {}, gaps {}, restarts {}, reguesses {}; {:.3g} frames/s\n",
              c.frames, c.samples, format_double(r.t_end), c.periods, c.events,
              r.interrupted ? " (interrupted)" : (r.alarm ? " (stopped at the first alarm)" : ""), c.dropped(),
              c.garbage, c.bad_dlc, c.out_of_range, c.time_back, c.bus_dropped, c.counter_jumps, c.stale, c.gaps,
-             c.restarts, r.wall_s > 0 ? double(c.frames) / r.wall_s : 0.0);
+             c.restarts, c.reguesses, r.wall_s > 0 ? double(c.frames) / r.wall_s : 0.0);
 }
 
 /// lash monitor --report DB -o PNG: every parameter over time with its 95 % band, events as lines.
@@ -120,6 +122,12 @@ int run(const CLI::App& sub, MonitorOptions& o) {
   const std::string config = o.est.config;
   o.est.config.clear();
   s.estimator = settings_sources(sub, o.est);
+  try {
+    s.mode = monitor::parse_estimate_mode(o.mode);
+  } catch (const std::invalid_argument& e) {
+    throw InputError("", 0, "--estimate", e.what());
+  }
+  s.online.reguess.enabled = !o.no_reguess;
   if (!config.empty()) monitor::apply_monitor_config(config, s);
   monitor::check_settings(s);  // exit 2 before anything is read or written
   can_cmd::install_stop_handler();
@@ -160,6 +168,13 @@ Command add_monitor(CLI::App& app) {
   sub->add_option("--window", s.window_s,
                   "Each estimate covers the samples of the last S seconds; memory and cost per period bounded "
                   "(default 120; 0: every sample since the start, unbounded)");
+  sub->add_option("--estimate", o->mode,
+                  "online (default): one persistent estimator, O(1) per period; window: each period "
+                  "re-estimates its --window from scratch, O(window) per period");
+  sub->add_option("--init", s.online.init_s,
+                  "online: the data-tuned settings and switching guesses are chosen from the first S seconds "
+                  "[s] (default 10)");
+  sub->add_flag("--no-reguess", o->no_reguess, "online: keep the switching guesses chosen at the start");
   sub->add_option("--record", s.record_csv, "Write the t,v,y samples exactly as fed to the estimator (CSV)");
   sub->add_option("--jsonl", s.jsonl, "One JSON object per period and per event; - = stdout");
   sub->add_option("--db", s.db, "SQLite history (WAL, one transaction per period)");

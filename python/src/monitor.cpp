@@ -45,7 +45,8 @@ struct Collected {
 pyb::dict monitor_log(const std::string& path, const std::string& dbc, const std::string& v, const std::string& y,
                       const std::string& model, const std::string& preset, double every, double dt, double window,
                       double stale_timeout, const std::string& record, const std::string& db,
-                      const std::string& jsonl, const pyb::kwargs& settings) {
+                      const std::string& jsonl, const std::string& estimate, double init,
+                      const pyb::kwargs& settings) {
   monitor::MonitorSettings s;
   s.source = path;
   s.dbc = dbc;
@@ -54,6 +55,8 @@ pyb::dict monitor_log(const std::string& path, const std::string& dbc, const std
   s.every_s = every;
   s.dt_s = dt;
   s.window_s = window;
+  s.mode = checked("estimate", [&] { return monitor::parse_estimate_mode(estimate); });
+  s.online.init_s = init;
   s.stale_timeout_s = stale_timeout;
   s.record_csv = record;
   s.db = db;
@@ -97,7 +100,7 @@ pyb::dict monitor_log(const std::string& path, const std::string& dbc, const std
   for (const auto& [k, x] : {std::pair{"frames", n.frames}, {"other", n.other}, {"samples", n.samples},
                              {"garbage", n.garbage}, {"bad_dlc", n.bad_dlc}, {"out_of_range", n.out_of_range},
                              {"counter_jumps", n.counter_jumps}, {"stale", n.stale}, {"time_back", n.time_back},
-                             {"gaps", n.gaps}, {"restarts", n.restarts}, {"bus_dropped", n.bus_dropped},
+                             {"gaps", n.gaps}, {"restarts", n.restarts}, {"reguesses", n.reguesses}, {"bus_dropped", n.bus_dropped},
                              {"periods", n.periods}, {"events", n.events}})
     counts[k] = x;
   out["counts"] = counts;
@@ -113,13 +116,17 @@ void bind_monitor(pyb::module_& m) {
   m.def("monitor_log", &monitor_log, pyb::arg("path"), pyb::arg("dbc"), pyb::arg("v"), pyb::arg("y"), pyb::kw_only(),
         pyb::arg("model") = "deadzone-deadband", pyb::arg("preset") = "lash", pyb::arg("every") = 1.0,
         pyb::arg("dt") = 0.0, pyb::arg("window") = 120.0, pyb::arg("stale_timeout") = 0.5,
-        pyb::arg("record") = "", pyb::arg("db") = "", pyb::arg("jsonl") = "",
+        pyb::arg("record") = "", pyb::arg("db") = "", pyb::arg("jsonl") = "", pyb::arg("estimate") = "online",
+        pyb::arg("init") = 10.0,
         "monitor_log(path, dbc, v, y, *, model='deadzone-deadband', preset='lash', every=1.0, dt=0.0,\n"
-        "            window=120.0, stale_timeout=0.5, record='', db='', jsonl='', **settings) -> dict\n\n"
+        "            window=120.0, stale_timeout=0.5, record='', db='', jsonl='', estimate='online', init=10.0,\n"
+        "            **settings) -> dict\n\n"
         "`lash monitor LOGFILE` as a library call (docs/monitor.md): a CAN log (candump, ASC, BLF, TRC) read\n"
         "through the DBC `dbc`; v, y: 'MSG.SIG' or 'MSG.SIG-MSG.SIG'; every: period of the estimates [s];\n"
         "dt > 0: zero-order-hold resampling [s]; window: each estimate covers the samples of the last\n"
-        "`window` seconds (0 = all); record / db / jsonl: the files of --record, --db, --jsonl ('' = none).\n"
+        "`window` seconds (0 = all; online: the final one); record / db / jsonl: the files of --record, --db,\n"
+        "--jsonl ('' = none); estimate: 'online' (one persistent estimator, settings chosen from the first\n"
+        "`init` seconds) or 'window' (each period re-estimates its window), as lash monitor --estimate.\n"
         "settings: the keys of a monitor config: the estimator's (as lash.estimate) and the tables alarms={...}\n"
         "and drift={...}. Returns the history, one entry per period: 't' [s since the first sample],\n"
         "'samples' (that the estimate used), 'status' (list of str), per parameter (c_r, c_l, d_r, d_l, K_r,\n"

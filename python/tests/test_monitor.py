@@ -103,7 +103,7 @@ def test_drift_event_and_window(files):
     rows = write_log(log, 40.0, c_r_after=400.0, t_change=20.0, seed=5)
     rec = tmp / "rec.csv"
     h = lash.monitor_log(str(log), dbc, "Cmd.CurrentA-Cmd.CurrentB", "Sens.Pressure", model="input-deadzone",
-                         window=10.0, record=str(rec), rls={"lambda": 0.995})
+                         window=10.0, record=str(rec), rls={"lambda": 0.995}, estimate="window")
     t_rec = [float(line.split(",")[0]) for line in rec.read_text().splitlines()[1:]]
     assert len(t_rec) == len(rows) and all(abs(a - r[0]) < 2e-6 for a, r in zip(t_rec, rows))
     ev = h["events"]
@@ -113,7 +113,7 @@ def test_drift_event_and_window(files):
     # (the edge is not identified for a few periods after the jump, and the test takes the running
     # median of 5 identified values: the event came at 30 s on the seed here)
     assert drift and 20.0 < drift[0][0] <= 35.0 and drift[0][1] < 350.0 < drift[0][2], ev
-    # window=10: each estimate used the samples of (T - 10, T]
+    # estimate="window", window=10: each estimate used the samples of (T - 10, T]
     for T, n in zip(h["t"], h["samples"]):
         assert n == sum(1 for t in t_rec if T - 10.0 < t <= T), (T, n)
     assert h["c_r"][-1] == pytest.approx(400.0, rel=0.05)
@@ -130,3 +130,21 @@ def test_bad_input_names_it(files):
     assert "lamda" in e.value.key
     with pytest.raises(lash.InputError):
         lash.monitor_log(str(tmp / "missing.log"), dbc, "Cmd.CurrentA", "Sens.Pressure")
+
+
+def test_online_drift_and_reguesses(files):
+    """The default persistent estimator on the drift log: the drift event after the change, the
+    right edge of the last period at the new value, the re-guess counts in the counts dict."""
+    tmp, dbc = files
+    log = tmp / "drift.log"
+    write_log(log, 40.0, c_r_after=400.0, t_change=20.0, seed=5)
+    h = lash.monitor_log(str(log), dbc, "Cmd.CurrentA-Cmd.CurrentB", "Sens.Pressure", model="input-deadzone",
+                         rls={"lambda": 0.995})
+    ev = h["events"]
+    assert all(t >= 20.0 for t in ev["t"]), ev
+    drift = [t for t, k, p in zip(ev["t"], ev["kind"], ev["param"]) if k == "drift" and p == "c_r"]
+    assert drift and 20.0 < drift[0] <= 35.0, ev
+    assert h["c_r"][-2] == pytest.approx(400.0, rel=0.05)  # the last period (the final line: the window's)
+    # the right guess searched on the first 10 s (c_r + 0.15 (v_max - c_r), about 360 mA) lies inside
+    # the deadzone after the change (400 mA): the side says wrong_guess and the guess moves out
+    assert h["counts"]["reguesses"] >= 1

@@ -57,15 +57,9 @@ PerSide<SideIntervals> batch_means_intervals(const EstimatorConfig& cfg, std::sp
                                              std::span<const double> y, const PerSide<SideParams>& estimate,
                                              const IntervalSettings& s) {
   if (v.size() != y.size()) throw std::invalid_argument("v and y differ in length");
-  PerSide<SideIntervals> out;
   const std::size_t n = v.size(), B = s.sections;
-  if (B < 2 || n / B < 2) return out;
+  if (B < 2 || n / B < 2) return {};
   const std::size_t len = n / B;
-  // per side, per parameter: the section estimates of identified sides
-  struct Samples {
-    std::vector<double> a1, b1, c, d, K, tau;
-  };
-  PerSide<Samples> sm;
   // Each section's estimator starts fresh. Sections b and b + half run in lockstep in one loop:
   // two independent recursions (each RLS update waits on its own last result) that the CPU
   // overlaps, where one after the other they left it waiting. Same samples, same order per
@@ -108,9 +102,21 @@ PerSide<SideIntervals> batch_means_intervals(const EstimatorConfig& cfg, std::sp
     }
     at[b] = {ea.params(Side::right), ea.params(Side::left)};
   }
-  for (std::size_t b = 0; b < B; ++b) {
+  return section_intervals(cfg, at, len, n, estimate, s.min_sections);
+}
+
+PerSide<SideIntervals> section_intervals(const EstimatorConfig& cfg, std::span<const PerSide<SideParams>> sections,
+                                         std::size_t len, std::size_t n, const PerSide<SideParams>& estimate,
+                                         std::size_t min_sections) {
+  PerSide<SideIntervals> out;
+  // per side, per parameter: the section estimates of identified sides
+  struct Samples {
+    std::vector<double> a1, b1, c, d, K, tau;
+  };
+  PerSide<Samples> sm;
+  for (const PerSide<SideParams>& sec : sections) {
     for (Side side : {Side::right, Side::left}) {
-      const SideParams p = at[b][side];
+      const SideParams& p = sec[side];
       if (!p.identified) continue;
       Samples& q = sm[side];
       q.a1.push_back(p.a1);
@@ -127,7 +133,7 @@ PerSide<SideIntervals> batch_means_intervals(const EstimatorConfig& cfg, std::sp
     const SideParams& e = estimate[side];
     const Samples& q = sm[side];
     SideIntervals& r = out[side];
-    const std::size_t m = s.min_sections;
+    const std::size_t m = min_sections;
     r.a1 = around(e.a1, q.a1, scale, m);
     r.b1 = around(e.b1, q.b1, scale, m);
     r.c = around(e.c, q.c, scale, m);

@@ -52,6 +52,12 @@ void apply_monitor_table(const toml::table& file, const std::string& path, Monit
   s.estimator.keys = keys.get();
 }
 
+EstimateMode parse_estimate_mode(const std::string& name) {
+  if (name == "online") return EstimateMode::online;
+  if (name == "window") return EstimateMode::window;
+  throw std::invalid_argument("unknown estimate mode '" + name + "' (expected online or window)");
+}
+
 namespace {
 
 void check_positive(double x, const char* field, bool zero_ok) {
@@ -82,6 +88,7 @@ std::string event_line(const Event& e) {
 class Pipeline {
  public:
   Pipeline(const MonitorSettings& s, SignalMap map) : s_(s), map_(std::move(map)), detector_(s.alarms) {
+    if (s.mode == EstimateMode::online) online_.emplace(s.estimator, s.online);
     if (!s.record_csv.empty()) {
       record_.open(s.record_csv, std::ios::out | std::ios::trunc);
       if (!record_) throw InputError(s.record_csv, 0, "--record", "cannot write the file");
@@ -181,7 +188,8 @@ class Pipeline {
       for (const auto& [k, v] : {std::pair{"frames", c.frames}, {"other", c.other}, {"samples", c.samples},
                                  {"garbage", c.garbage}, {"bad_dlc", c.bad_dlc}, {"out_of_range", c.out_of_range},
                                  {"counter_jumps", c.counter_jumps}, {"stale", c.stale}, {"time_back", c.time_back},
-                                 {"gaps", c.gaps}, {"restarts", c.restarts}, {"bus_dropped", c.bus_dropped},
+                                 {"gaps", c.gaps}, {"restarts", c.restarts}, {"reguesses", c.reguesses},
+                                 {"bus_dropped", c.bus_dropped},
                                  {"periods", c.periods}, {"events", c.events}})
         m[std::string("count_") + k] = std::to_string(v);
       db_->set_meta(m);
@@ -233,11 +241,13 @@ class Pipeline {
       next_period_ = (std::floor(t / s_.every_s) + 1.0) * s_.every_s;
       if (alarm_ && s_.until_alarm) return !(stopped_ = true);
     }
-    if (restart_pending_ && !t_.empty()) extra_gaps_.push_back(t_.size());
+    const bool restart = restart_pending_ && !t_.empty();
+    if (restart) extra_gaps_.push_back(t_.size());
     restart_pending_ = false;
     t_.push_back(t);
     v_.push_back(v);
     y_.push_back(y);
+    if (online_) online_->add(t, v, y, restart);
     ++counts_.samples;
     if (s_.on_sample) s_.on_sample(t, v, y);  // the console's observer (monitor.hpp)
     if (record_.is_open()) record_ << format_double(t) << ',' << format_double(v) << ',' << format_double(y) << '\n';
@@ -275,21 +285,35 @@ class Pipeline {
     const std::size_t m = n - b;
     p.samples = m;
     last_snapshot_total_ = trimmed_ + n;
-    if (m >= 3) {
+    const double t_from = last_period_t_;
+    last_period_t_ = t;
+    const bool online_period = online_ && status != "final" && online_->ready();
+    if (online_period) {
+      // the persistent estimator's state now: O(1) whatever the window (online.hpp)
+      auto snap = online_->snapshot(t_from, t);
+      p.json = std::move(snap->json);
+      p.params = monitored_params(snap->report);
+      p.samples = trimmed_ + n;  // the samples received up to T (the estimator has stepped all but
+                                 // the last, held for the outlier gate's look-ahead: the JSON's samples)
+    } else if (m >= 3) {
+      // the window's estimate from scratch: mode window, the final estimate, and (online) the
+      // periods of the first online.init_s seconds, before the settings are chosen
       const std::span<const double> tt(t_.data() + b, m), vv(v_.data() + b, m), yy(y_.data() + b, m);
       Sampling smp = analyse_sampling(tt);
-      for (const std::size_t r : smp.gap_rows)  // gaps counted once over the run (windows overlap)
-        if (trimmed_ + b + r > last_gap_row_) {
-          ++counts_.gaps;
-          last_gap_row_ = trimmed_ + b + r;
-        }
+      if (!online_) {
+        for (const std::size_t r : smp.gap_rows)  // gaps counted once over the run (windows overlap)
+          if (trimmed_ + b + r > last_gap_row_) {
+            ++counts_.gaps;
+            last_gap_row_ = trimmed_ + b + r;
+          }
+      }
       if (!extra_gaps_.empty()) {
         for (const std::size_t r : extra_gaps_)
           if (r > b && r < n) smp.gap_rows.push_back(r - b);
         std::sort(smp.gap_rows.begin(), smp.gap_rows.end());
         smp.gap_rows.erase(std::unique(smp.gap_rows.begin(), smp.gap_rows.end()), smp.gap_rows.end());
       }
-      counts_.restarts = smp.gap_rows.size();
+      if (!online_) counts_.restarts = smp.gap_rows.size();
       ArrayEstimateOptions eo;
       eo.sampling = &smp;
       try {
@@ -304,7 +328,16 @@ class Pipeline {
     } else {
       p.status = "warming_up";
     }
-    if (!p.params.empty()) detector_.update(t, p.params, pending_events_);
+    if (online_) {
+      counts_.gaps = online_->gaps();
+      counts_.restarts = online_->restarts();
+      counts_.reguesses = online_->reguesses(Side::right) + online_->reguesses(Side::left);
+    }
+    // online: the final estimate (over the window, from scratch) is another estimator than the
+    // periods'; the detector follows the periods' only
+    // online: the detector follows the persistent estimator's periods only (not the window
+    // estimates of the first init_s seconds nor the final one: other estimators, other levels)
+    if (!p.params.empty() && !(online_ && !online_period)) detector_.update(t, p.params, pending_events_);
     p.events = std::move(pending_events_);
     pending_events_.clear();
     for (const Event& e : p.events)
@@ -337,6 +370,8 @@ class Pipeline {
   std::ofstream record_;
   std::FILE* jsonl_ = nullptr;
   std::optional<HistoryDb> db_;
+  std::optional<OnlineEstimator> online_;
+  double last_period_t_ = 0.0;  ///< end of the previous period [s]
   std::vector<double> t_, v_, y_;
   std::vector<std::size_t> extra_gaps_;  ///< rows where a silence or counter jump restarts the regressors
   std::vector<Event> pending_events_;
@@ -366,6 +401,12 @@ void check_settings(const MonitorSettings& s) {
   check_positive(s.stale_timeout_s, "--stale-timeout", false);
   check_positive(s.window_s, "--window", true);
   check_positive(s.duration_s, "--duration", true);
+  check_positive(s.online.init_s, "--init", false);
+  try {
+    s.online.reguess.validate();
+  } catch (const std::invalid_argument& e) {
+    throw InputError("", 0, "reguess", e.what());
+  }
   resolve_settings(s.estimator);
   (void)make_map(s);
 }

@@ -6,8 +6,9 @@ no-drift scenario, then, on their master_bus.log:
    (little-endian 16-bit fields times the DBC factor), paired as the master pairs them;
  - the last JSON line of `lash monitor ... --jsonl -` equals `lash estimate rec.csv --json` byte for byte
    (the run, 40 s, is shorter than the default 120 s window: the estimate covers every sample);
-   with --window 10 it equals `lash estimate` of the record's rows of the last 10 s, and every
-   period's sample count is the number of record rows in (T - 10, T];
+   with --window 10 it equals `lash estimate` of the record's rows of the last 10 s, and (with
+   --estimate window, each period re-estimated over its window) every period's sample count is
+   the number of record rows in (T - 10, T];
  - a `drift` event on c_r between 20 and 25 s and no event before 20 s; none on the no-drift run;
  - the SQLite history (read with Python's sqlite3) passes integrity_check and holds one period
    per JSON estimate line; `kill -9` of a monitor writing a database leaves a database that
@@ -108,7 +109,10 @@ print("last JSON line == lash estimate rec.csv --json")
 # the sliding window (--window 10): each period's estimate covers the record's rows with
 # T - 10 < t <= T; the last line equals lash estimate of those rows (selected here from rec.csv)
 wdb, wrec = os.path.join(tmp, "w10.sqlite"), os.path.join(tmp, "w10.csv")
-r10 = monitor(log, "--window", "10", "--record", wrec, "--jsonl", "-", "--db", wdb)
+r10 = monitor(log, "--estimate", "window", "--window", "10", "--record", wrec, "--jsonl", "-", "--db", wdb)
+o10 = monitor(log, "--window", "10", "--jsonl", "-")  # the persistent estimator: the same final line
+assert [x for x in o10.stdout.splitlines() if '"event"' not in x][-1] == \
+    [x for x in r10.stdout.splitlines() if '"event"' not in x][-1]
 with open(wrec) as f:
     wlines = f.read().splitlines()
 assert wlines[1:] == open(rec).read().splitlines()[1:], "the record holds every sample, window or not"

@@ -9,8 +9,14 @@ holds them, and runs `lash monitor` on the candump -L log.
  - valve_deadzone_drift (right edge 288 -> 380 mA at 20 s): a `drift` event on c_r between 20
    and 25 s and none before 20 s (so the detector does fire on these logs);
  - the no-drift log damaged (2 % garbage lines, a 5 s silence, a counter jump): exit 0, the counts
-   in the summary equal those put in, and with --window 5 every period whose window (T - 5, T]
-   lies outside the damaged stretches has the estimate of the clean log, byte for byte.
+   in the summary equal those put in; with `--estimate window --window 5` every period whose window
+   (T - 5, T] lies outside the damaged stretches has the estimate of the clean log, byte for byte;
+   with the default persistent estimator every period before the silence equals the clean log's
+   byte for byte, and after it the right edge stays within 5 % of the clean log's;
+ - online re-guessing: the drift log with switching guesses given far inside the deadzone
+   (+-150 mA; the edges are 288 -> 380 and -296 mA): the guesses move (re-guesses counted in the
+   JSON and the summary), and the last period's edges lie within 5 % of the truth (380, -296 mA);
+   without re-guessing (--no-reguess) the right side stays `wrong_guess`.
 """
 import json
 import os
@@ -102,8 +108,8 @@ for i, line in enumerate(clean):
         out.append(f"garbage {i} ###")
         garbage += 1
 clean_log, bad_log = write("clean.log", clean), write("damaged.log", out)
-c_est, _, _ = monitor(clean_log, "--window", "5")
-d_est, d_ev, err = monitor(bad_log, "--window", "5")
+c_est, _, _ = monitor(clean_log, "--estimate", "window", "--window", "5")
+d_est, d_ev, err = monitor(bad_log, "--estimate", "window", "--window", "5")
 summary = dict(re.findall(r"(garbage|counter_jumps|stale) (\d+)", err))
 assert summary == {"garbage": str(garbage), "counter_jumps": "1", "stale": "1"}, err
 assert [e["event"] for e in d_ev if e["event"] in ("stale", "resumed")] == ["stale", "resumed"], d_ev
@@ -125,3 +131,40 @@ for e in d_est:
 assert same >= 20, same
 print(f"damaged log: {garbage} garbage lines, 1 silence, 1 counter jump counted; {same} periods outside the damage "
       f"equal the clean log's")
+
+# the persistent estimator (default): identical until the damage, close to the clean log after it
+co_est, _, _ = monitor(clean_log, "--quiet")
+do_est, _, err = monitor(bad_log)
+summary = dict(re.findall(r"(garbage|counter_jumps|stale) (\d+)", err))
+assert summary == {"garbage": str(garbage), "counter_jumps": "1", "stale": "1"}, err
+co_by_t = {round(e["t"], 6): e for e in co_est[:-1]}
+before, after = 0, 0
+for e in do_est[:-1]:  # the periods (the last line is the final window estimate)
+    T = round(e["t"], 6)
+    c = co_by_t[T]
+    if T < silence[0]:
+        assert e == c, (T, e, c)
+        before += 1
+    elif T > silence[1] + 3 and e["right"]["identified"] and c["right"]["identified"]:
+        assert abs(e["right"]["c"] - c["right"]["c"]) < 0.05 * abs(c["right"]["c"]), (T, e["right"], c["right"])
+        after += 1
+assert before >= 2 and after >= 10, (before, after)
+print(f"damaged log, persistent estimator: {before} periods before the silence equal the clean log's, "
+      f"{after} after it within 5 % on c_r")
+
+# --- online re-guessing: guesses given far inside the deadzone -----------------------------------
+drift_log = os.path.join(tmp, "drift.log")
+est, _, err = monitor(drift_log, "--guess-right", "150", "--guess-left", "-150")
+periods = est[:-1]
+n_r, n_l = periods[-1]["reguesses"]["right"], periods[-1]["reguesses"]["left"]
+assert n_r >= 1 and n_l >= 1, periods[-1]["reguesses"]
+assert re.search(r"reguesses (\d+)", err).group(1) == str(n_r + n_l), err
+last = periods[-1]
+assert last["right"]["identified"] and abs(last["right"]["c"] - 380) < 0.05 * 380, last["right"]
+assert last["left"]["identified"] and abs(last["left"]["c"] + 296) < 0.05 * 296, last["left"]
+assert last["right"]["guess"]["value"] > 380 and last["left"]["guess"]["value"] < -296, (last["right"], last["left"])
+frozen, _, _ = monitor(drift_log, "--guess-right", "150", "--guess-left", "-150", "--no-reguess", "--quiet")
+assert frozen[-2]["right"]["reason"] == "wrong_guess" and frozen[-2]["reguesses"] == {"right": 0, "left": 0}, \
+    frozen[-2]["right"]
+print(f"re-guessing from +-150 mA: {n_r} right / {n_l} left moves; last period c_r = {last['right']['c']:.1f} mA "
+      f"(true 380), c_l = {last['left']['c']:.1f} mA (true -296); without it the right side stays wrong_guess")

@@ -3,11 +3,17 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
 #include "lash/can/dbc.hpp"
 #include "lash/io/error.hpp"
 #include "lash/metrics/page_hinkley.hpp"
+#include "lash/identify/any_estimator.hpp"
+#include "lash/identify/config_sources.hpp"
+#include "lash/io/table.hpp"
 #include "lash/monitor/events.hpp"
+#include "lash/monitor/online.hpp"
 #include "lash/monitor/signal_map.hpp"
 
 namespace lash {
@@ -148,6 +154,87 @@ TEST(MonitorEvents, ThresholdOnce) {
   EXPECT_DOUBLE_EQ(ev[0].before, 30);
   EXPECT_DOUBLE_EQ(ev[0].after, 45);
   EXPECT_DOUBLE_EQ(ev[1].t, 5);
+}
+
+// The persistent estimator is the estimator `lash estimate` runs, stepped once per sample: with the
+// guesses given, no gate and no re-guessing, its state after a record equals an AnyEstimator with the
+// settings resolved from the first init_s seconds stepped over the same samples (all but the last,
+// held for the gate's look-ahead), bit for bit; with re-guessing on and guesses far inside the
+// deadzone, the guesses move out and the edges come within 5 % of the plant's.
+struct DeadzoneRecord {
+  std::vector<double> t, v, y;
+};
+DeadzoneRecord deadzone_record(std::size_t n, double c_r, double c_l) {
+  DeadzoneRecord r;
+  std::uint64_t rng = 12345;
+  const auto uniform = [&] {  // a fixed LCG: the same bits on every standard library
+    rng = rng * 6364136223846793005ULL + 1442695040888963407ULL;
+    return static_cast<double>(rng >> 11) * 0x1p-53;
+  };
+  double level = 0.0, y = 0.0, v1 = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (k % 37 == 0) level = -700.0 + 1400.0 * uniform();
+    const double dz = v1 > c_r ? v1 - c_r : (v1 < c_l ? v1 - c_l : 0.0);
+    y = 0.9 * y + 0.2 * dz + 0.2 * (uniform() - 0.5);
+    r.t.push_back(0.005 * static_cast<double>(k));
+    r.v.push_back(level);
+    r.y.push_back(y);
+    v1 = level;
+  }
+  return r;
+}
+
+TEST(MonitorOnline, EqualsTheEstimatorSteppedOnce) {
+  const DeadzoneRecord r = deadzone_record(6000, 300.0, -250.0);
+  SettingsSources src;
+  src.model = ModelKind::input_deadzone;
+  src.options = {{"guess-right", "400"}, {"guess-left", "-350"}};
+  monitor::OnlineSettings os;
+  os.init_s = 5.0;
+  os.outlier_gate = 0.0;
+  os.reguess.enabled = false;
+  monitor::OnlineEstimator on(src, os);
+  for (std::size_t k = 0; k < r.t.size(); ++k) on.add(r.t[k], r.v[k], r.y[k], false);
+  ASSERT_TRUE(on.ready());
+  // the first stretch: t - t0 >= 5 s at sample 1000 (5.000 s), samples 0..1000
+  const std::size_t m = 1001;
+  const std::span<const double> ts(r.t.data(), m), vs(r.v.data(), m), ys(r.y.data(), m);
+  const EstimatorConfig cfg = resolve_settings(src, analyse_sampling(ts).dt, vs, ys).cfg;
+  AnyEstimator ref(cfg);
+  for (std::size_t k = 0; k + 1 < r.t.size(); ++k) ref.step(r.v[k], r.y[k]);
+  const auto snap = on.snapshot(0.0, r.t.back());
+  ASSERT_TRUE(snap.has_value());
+  EXPECT_EQ(on.samples(), r.t.size() - 1);
+  for (const Side s : {Side::right, Side::left}) {
+    const SideParams a = (s == Side::right ? snap->report.right : snap->report.left).params, b = ref.params(s);
+    EXPECT_EQ(a.a1, b.a1);
+    EXPECT_EQ(a.b1, b.b1);
+    EXPECT_EQ(a.c, b.c);
+    EXPECT_EQ(on.reguesses(s), 0u);
+  }
+  EXPECT_NEAR(ref.params(Side::right).c, 300.0, 15.0);  // the plant's edges (the estimator converged)
+  EXPECT_NEAR(ref.params(Side::left).c, -250.0, 12.5);
+}
+
+TEST(MonitorOnline, ReguessesAGuessInsideTheDeadzone) {
+  const DeadzoneRecord r = deadzone_record(12000, 300.0, -250.0);
+  SettingsSources src;
+  src.model = ModelKind::input_deadzone;
+  src.options = {{"guess-right", "100"}, {"guess-left", "-100"}};  // inside [-250, 300]
+  monitor::OnlineSettings os;
+  os.init_s = 5.0;
+  monitor::OnlineEstimator on(src, os);
+  for (std::size_t k = 0; k < r.t.size(); ++k) on.add(r.t[k], r.v[k], r.y[k], false);
+  const auto snap = on.snapshot(0.0, r.t.back());
+  ASSERT_TRUE(snap.has_value());
+  EXPECT_GE(on.reguesses(Side::right), 1u);
+  EXPECT_GE(on.reguesses(Side::left), 1u);
+  EXPECT_GT(on.config()->guess_right, 300.0);
+  EXPECT_LT(on.config()->guess_left, -250.0);
+  EXPECT_TRUE(snap->report.right.params.identified);
+  EXPECT_TRUE(snap->report.left.params.identified);
+  EXPECT_NEAR(snap->report.right.params.c, 300.0, 15.0);
+  EXPECT_NEAR(snap->report.left.params.c, -250.0, 12.5);
 }
 
 }  // namespace

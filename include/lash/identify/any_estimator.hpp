@@ -76,6 +76,10 @@ class AnyEstimator {
   std::uint64_t skipped() const noexcept {
     return std::visit([](const auto& e) noexcept { return e.skipped(); }, e_);
   }
+  /// Updates of side s's recursion so far (linear: the model's). noexcept.
+  std::uint64_t updates(Side s) const noexcept {
+    return std::visit([s](const auto& e) noexcept { return e.updates(s); }, e_);
+  }
   std::uint64_t samples() const noexcept { return samples_; }
   /// After a gap in the record: clears the signal history, keeps the estimates (estimators.hpp).
   /// noexcept, allocation-free.

@@ -47,6 +47,14 @@ PerSide<SideIntervals> batch_means_intervals(const EstimatorConfig& cfg, std::sp
                                              std::span<const double> y, const PerSide<SideParams>& estimate,
                                              const IntervalSettings& s = {});
 
+/// The same intervals from section estimates already at hand (each section's per-side
+/// parameters, identified or not, in order; the monitor's online sections, docs/monitor.md):
+/// the estimator's memory over `section_len` samples against `n` samples sets the scale.
+/// batch_means_intervals computes its sections and calls this.
+PerSide<SideIntervals> section_intervals(const EstimatorConfig& cfg, std::span<const PerSide<SideParams>> sections,
+                                         std::size_t section_len, std::size_t n,
+                                         const PerSide<SideParams>& estimate, std::size_t min_sections = 5);
+
 /// Student's t quantile t_{0.975, dof} for dof ≥ 1 (table to 30, then the normal-limit series).
 double student_t975(std::size_t dof) noexcept;
 

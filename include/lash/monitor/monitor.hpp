@@ -10,9 +10,12 @@
 /// Sampling: each frame of y's message is one sample (t = the frame's time, v = the latest v
 /// received before it), or with dt_s > 0 a zero-order hold at t0 + k·dt (v and y the latest
 /// values received at or before that instant). t is in seconds since the first sample.
-/// Each period's estimate is estimate_arrays over the samples of the last window_s seconds
-/// (default 120 s; 0 = every sample so far), restarted at the record's timestamp gaps (as `lash estimate`)
-/// and where a silence or an alive-counter jump was seen: the last one equals
+/// Each period's estimate (mode online, the default) is a snapshot of one persistent estimator
+/// fed every sample (online.hpp: settings and guesses from the first stretch, re-guessing,
+/// O(1) per period); mode window: estimate_arrays over the samples of the last window_s seconds.
+/// The final estimate, in both modes, is estimate_arrays over the last window_s seconds (default
+/// 120 s; 0 = every sample so far), restarted at the record's timestamp gaps (as `lash estimate`)
+/// and where a silence or an alive-counter jump was seen: it equals
 /// `lash estimate RECORD.csv --json` on the rows of the record in the last window.
 /// One library call serves the CLI and Python. Not real-time code.
 #include <atomic>
@@ -25,8 +28,17 @@
 #include "lash/identify/config_sources.hpp"
 #include "lash/monitor/events.hpp"
 #include "lash/monitor/history.hpp"
+#include "lash/monitor/online.hpp"
 
 namespace lash::monitor {
+
+/// How each period's estimate is made (docs/monitor.md, "Estimator").
+enum class EstimateMode : std::uint8_t {
+  online,  ///< one persistent estimator fed per sample (online.hpp): O(1) per period
+  window   ///< estimate_arrays over the period's window from scratch: O(window) per period
+};
+/// "online" or "window"; std::invalid_argument otherwise.
+EstimateMode parse_estimate_mode(const std::string& name);
 
 struct MonitorSettings {
   std::string source;    ///< bus address or log file (source.hpp)
@@ -42,6 +54,8 @@ struct MonitorSettings {
   /// (T = the period's end), and the monitor keeps at most 2·window_s seconds of samples (bounded
   /// memory and cost per period); 0: every sample since the start (memory and cost grow with the run) [s]
   double window_s = 120.0;
+  EstimateMode mode = EstimateMode::online;  ///< per-period estimate (the final one is always the window's)
+  OnlineSettings online;           ///< the persistent estimator's settings (mode online)
   double duration_s = 0.0;         ///< > 0: stop after this long (frame time; live: also wall time) [s]
   bool realtime = false;           ///< a log at its recorded pace
   bool until_alarm = false;        ///< stop after the period with the first drift/threshold event
@@ -76,6 +90,7 @@ struct MonitorCounts {
   std::uint64_t time_back = 0;      ///< samples not after the previous one (skipped)
   std::uint64_t gaps = 0;           ///< timestamp gaps of the samples (> 5 median steps; restart)
   std::uint64_t restarts = 0;       ///< regressor restarts in the estimated samples
+  std::uint64_t reguesses = 0;      ///< moves of a switching guess by the online re-guessing (both sides)
   std::uint64_t bus_dropped = 0;    ///< frames the bus dropped
   std::uint64_t periods = 0;
   std::uint64_t events = 0;
