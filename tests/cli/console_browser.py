@@ -22,7 +22,6 @@ import csv
 import json
 import os
 import re
-import shutil
 import struct
 import subprocess
 import sys
@@ -32,18 +31,9 @@ import urllib.error
 import urllib.request
 
 LASH = os.environ.get("LASH", "lash")
-CHROMIUM = shutil.which("chromium")
-DRIVER = shutil.which("chromedriver") or "/usr/bin/chromedriver"
-try:
-    from selenium import webdriver
-    from selenium.webdriver.chrome.service import Service
-    from selenium.webdriver.common.by import By
-except ImportError:
-    print("SKIP: python3-selenium is not installed")
-    sys.exit(77)
-if not CHROMIUM or not os.path.exists(DRIVER):
-    print("SKIP: chromium or chromium-driver is not installed")
-    sys.exit(77)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import browser  # noqa: E402  (the shared headless chromium; exits 77 when it is missing)
+from browser import By  # noqa: E402
 
 
 T0 = time.time()
@@ -63,17 +53,6 @@ def post(url, body, headers):
         return e.code
 
 
-def browser(profile):
-    o = webdriver.ChromeOptions()
-    o.binary_location = CHROMIUM
-    for a in ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-              "--disable-background-networking", "--disable-component-update", "--disable-sync",
-              "--disable-dev-shm-usage", f"--user-data-dir={profile}", "--window-size=1400,1100"]:
-        o.add_argument(a)
-    o.set_capability("goog:loggingPrefs", {"browser": "ALL"})
-    return webdriver.Chrome(service=Service(DRIVER), options=o)
-
-
 def canvas_png(driver):
     c = driver.find_element(By.CSS_SELECTOR, '[data-scope="pressure"] canvas')
     return c.screenshot_as_png
@@ -89,15 +68,15 @@ with tempfile.TemporaryDirectory() as tmp:
         line = run.stderr.readline()
         if not line:
             break
-        m = re.search(r"lash console: (http://127\.0\.0\.1:(\d+)/\?token=([0-9a-f]{32}))$", line.strip())
+        m = browser.lash_url(line)
         if m:
-            url, port, token = m.group(1), m.group(2), m.group(3)
+            url, port, token = m
     if url is None:
         run.kill()
         fail("no console URL printed")
     print("URL printed:", re.sub(r"token=\w+", "token=...", url))
     base = f"http://127.0.0.1:{port}"
-    d = browser(os.path.join(tmp, "profile"))
+    d = browser.chrome(os.path.join(tmp, "profile"))
     try:
         d.get(url)
         time.sleep(3)
@@ -190,7 +169,7 @@ with tempfile.TemporaryDirectory() as tmp:
         print(f"page: {fps:.1f} frames/s (requestAnimationFrame over 10 s); drops {drops}")
         if os.environ.get("LASH_CONSOLE_SHOT"):
             d.save_screenshot(os.environ["LASH_CONSOLE_SHOT"])
-        errors = [e for e in d.get_log("browser") if e.get("level") == "SEVERE"]
+        errors = browser.severe_errors(d)
         if errors:
             fail(f"console errors in the page: {errors}")
         print("no console errors")

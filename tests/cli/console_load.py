@@ -16,8 +16,6 @@
 Skips (77) when chromium, its driver or selenium is missing. LASH_CONSOLE_SHOT=FILE saves a screenshot."""
 import json
 import os
-import re
-import shutil
 import struct
 import subprocess
 import sys
@@ -26,18 +24,9 @@ import time
 import urllib.request
 
 LASH = os.environ.get("LASH", "lash")
-CHROMIUM = shutil.which("chromium")
-DRIVER = shutil.which("chromedriver") or "/usr/bin/chromedriver"
-try:
-    from selenium import webdriver
-    from selenium.webdriver.chrome.service import Service
-    from selenium.webdriver.common.by import By
-except ImportError:
-    print("SKIP: python3-selenium is not installed")
-    sys.exit(77)
-if not CHROMIUM or not os.path.exists(DRIVER):
-    print("SKIP: chromium or chromium-driver is not installed")
-    sys.exit(77)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import browser  # noqa: E402  (the shared headless chromium; exits 77 when it is missing)
+from browser import By  # noqa: E402
 MIN_REDRAWS = float(os.environ.get("LASH_CONSOLE_MIN_REDRAWS", "10"))
 MAX_GROWTH_KB = int(os.environ.get("LASH_CONSOLE_MAX_RSS_GROWTH_KB", "3072"))
 DURATION = int(os.environ.get("LASH_CONSOLE_LOAD_S", "45"))
@@ -71,21 +60,14 @@ with tempfile.TemporaryDirectory() as tmp:
         line = run.stderr.readline()
         if not line:
             fail("no console URL printed")
-        m = re.search(r"lash console: (http://127\.0\.0\.1:(\d+)/\?token=([0-9a-f]{32}))$", line.strip())
-    url, port, token = m.group(1), m.group(2), m.group(3)
+        m = browser.lash_url(line)
+    url, port, token = m
     base = f"http://127.0.0.1:{port}"
     meta = json.loads(get(base + "/api/meta", token))
     print(f"{len(meta['signals'])} signals; decimator memory {meta['memory_bytes']} bytes (fixed at start)")
     if len(meta["signals"]) != 32:
         fail("want 32 signals")
-    o = webdriver.ChromeOptions()
-    o.binary_location = CHROMIUM
-    for a in ["--headless", "--no-sandbox", "--disable-gpu", "--no-first-run", "--disable-background-networking",
-              "--disable-component-update", "--disable-sync", "--disable-dev-shm-usage",
-              f"--user-data-dir={os.path.join(tmp, 'profile')}", "--window-size=1400,1100"]:
-        o.add_argument(a)
-    o.set_capability("goog:loggingPrefs", {"browser": "ALL"})
-    d = webdriver.Chrome(service=Service(DRIVER), options=o)
+    d = browser.chrome(os.path.join(tmp, "profile"))
     try:
         d.get(url)
         while time.time() - t_start < 10:
@@ -112,7 +94,7 @@ with tempfile.TemporaryDirectory() as tmp:
         print("drop counters shown: drops", shown[0], "stalls", shown[1])
         if os.environ.get("LASH_CONSOLE_SHOT"):
             d.save_screenshot(os.environ["LASH_CONSOLE_SHOT"])
-        errors = [e for e in d.get_log("browser") if e.get("level") == "SEVERE"]
+        errors = browser.severe_errors(d)
         if errors:
             fail(f"console errors in the page: {errors}")
         if redraws < MIN_REDRAWS:
