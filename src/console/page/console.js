@@ -24,7 +24,8 @@
   let meta = null, panels = [], estPanels = new Map(), paused = false, store = null, dirty = false;
   let since = 0, estSince = 0, events = [], fetching = false, lastDraw = 0, stalls = 0, status = null;
   let retryAt = 0, frames = 0, draws = 0, fps = 0, drawsPerS = 0, t0 = performance.now(), lastEst = 0;
-  let columns = 0, winS = 10;
+  let columns = 0, winS = 10, lastAsk = 0;
+  const ASK_MS = 8;  // at most one /api/frame request per 8 ms (125/s)
   // read by the browser test: rAF callbacks, data redraws, stalls (monotonic counts)
   window.lashStats = { frames: 0, draws: 0, stalls: 0, fps: 0, drawsPerS: 0, bytes: 0, renderMs: 0 };
 
@@ -310,13 +311,15 @@
   // width or signal set) and puts them in its rings.
   async function fetchFrame() {
     fetching = true;
+    lastAsk = performance.now();
+    let again = true;  // false after an error: then the animation frames retry (retryAt)
     try {
       const want = [...new Set(panels.flatMap((p) => p.idx))].sort((a, b) => a - b);
       const key = `${winS}|${columns}|${want.join(",")}`;
       let url = `/api/frame?window=${winS}&columns=${columns}&sig=${want.join(",")}`;
       if (store && store.key === key && store.last !== null) url += `&from=${store.last - store.margin}`;
       const r = await fetch(url, { headers: H });
-      if (!r.ok) { $("conn").textContent = "server: " + r.status; retryAt = performance.now() + 1000; return; }
+      if (!r.ok) { $("conn").textContent = "server: " + r.status; retryAt = performance.now() + 1000; again = false; return; }
       const buf = await r.arrayBuffer();
       window.lashStats.bytes += buf.byteLength;
       if (paused) return;
@@ -342,12 +345,17 @@
       if (ncol > 0) s.last = s.last === null ? first + ncol - 1 : Math.max(s.last, first + ncol - 1);
       s.t_end = t_end; s.samples = dv.getFloat64(48, true); s.drops = dv.getFloat64(56, true);
       if (s.last !== null) dirty = true;
-      $("conn").textContent = "live";
+      if ($("conn").textContent !== "live") $("conn").textContent = "live";
     } catch (e) {
       $("conn").textContent = "disconnected";
+      again = false;
       retryAt = performance.now() + 1000;  // the server is gone: ask again in a second, not every frame
     } finally {
       fetching = false;
+      // the next request as soon as this answer is in, not at the next animation frame (a round
+      // trip longer than a frame would halve the redraws), but at most one per ASK_MS
+      if (again && !paused) setTimeout(() => { if (!fetching && !paused) fetchFrame(); },
+        Math.max(0, lastAsk + ASK_MS - performance.now()));
     }
   }
 
@@ -461,7 +469,7 @@
     frames++;
     window.lashStats.frames++;
     if (dirty && !paused) { dirty = false; render(); }
-    if (!fetching && !paused && now >= retryAt) fetchFrame();
+    if (!fetching && !paused && now >= retryAt && now - lastAsk > 100) fetchFrame();  // (re)start the stream
     if (now - t0 >= 1000) {
       fps = frames * 1000 / (now - t0); drawsPerS = draws * 1000 / (now - t0);
       window.lashStats.fps = fps; window.lashStats.drawsPerS = drawsPerS;
