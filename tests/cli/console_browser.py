@@ -1,5 +1,6 @@
 """Issue 27, the live console, tested in a real browser (Debian's chromium + chromium-driver,
-python3-selenium): `lash hil run --duration 20 --console 0`, then
+python3-selenium): `lash hil run --duration 50 --console 0` (long enough for every step below on a loaded
+machine: the browser must go away while the run goes on), then
 
 1. the page loads from the printed URL with no console errors (and nothing from elsewhere:
    the server's Content-Security-Policy is default-src 'self');
@@ -60,7 +61,7 @@ def canvas_png(driver):
 
 with tempfile.TemporaryDirectory() as tmp:
     out = os.path.join(tmp, "run")
-    run = subprocess.Popen([LASH, "hil", "run", "--duration", "35", "--console", "0", "--out-dir", out],
+    run = subprocess.Popen([LASH, "hil", "run", "--duration", "50", "--console", "0", "--out-dir", out],
                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     url = None
     t_end = time.time() + 15
@@ -174,8 +175,11 @@ with tempfile.TemporaryDirectory() as tmp:
             fail(f"console errors in the page: {errors}")
         print("no console errors")
     finally:
+        mid_run = run.poll() is None
         d.quit()  # the browser goes away mid-run
     print("browser closed at t_run ~", round(time.time() - t_set, 1), "s after the change")
+    if not mid_run:
+        fail("the run had ended before the browser was closed (not a mid-run close)")
     rest_out, rest_err = run.communicate(timeout=60)
     if run.returncode != 0:
         fail(f"lash hil run exited {run.returncode}: {rest_err[-2000:]}")
