@@ -4,7 +4,7 @@
 1. the page loads with no console errors and draws the 32 signals in four scopes;
 2. frames per second measured in the page, requestAnimationFrame callbacks counted over 10 s
    (window.lashStats.frames), >= 30 (the issue's figure), and data redraws (window.lashStats.draws:
-   one per /api/frame answer with new columns painted) over the same 10 s >= 30 too: the page
+   one per /api/frame answer painted) over the same 10 s >= 30 too: the page
    streams only the columns it lacks and paints them into an ImageData (docs/console.md), cheap
    enough that a loaded machine (two shared cores running the server, the producer and a
    software-rendered chromium) still gives both; the main-thread time per redraw is printed;

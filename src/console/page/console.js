@@ -372,7 +372,7 @@
       ["samples", d.samples, "samples in the decimator"],
       ["t_s", s ? s.t_end.toFixed(3) : "-", "time of the newest sample (the scopes' 0) [s]"],
       ["frames/s", fps.toFixed(1), "requestAnimationFrame callbacks per second"],
-      ["redraws/s", drawsPerS.toFixed(1), "data redraws per second (one per /api/frame answer with new data)"],
+      ["redraws/s", drawsPerS.toFixed(1), "data redraws per second (one per /api/frame answer painted)"],
       ["bucket_ms", s ? (s.bucket_s * 1e3).toFixed(1) : "-", "decimation bucket of the window [ms]"]];
     for (const [k, v] of Object.entries(d.status_text || {})) rows.push([k, v, "", /lost|cannot|stale/.test(v)]);
     for (const [k, v] of Object.entries(d.status || {})) rows.push([k, v, ""]);
