@@ -102,10 +102,11 @@ DecimatedView Decimator::view(double t_end, double window_s, std::size_t columns
 }
 
 std::size_t Decimator::view_f32(double t_end, double window_s, std::size_t columns, std::span<const std::size_t> signals,
-                                std::vector<float>& out, double& t0_s, double& col_s, double& bucket_s) const {
+                                std::vector<float>& out, double& t0_s, double& col_s, double& bucket_s,
+                                std::int64_t from_col) const {
   out.clear();
   t0_s = col_s = bucket_s = 0.0;
-  if (!(window_s > 0.0) || columns == 0) return 0;
+  if (!(window_s > 0.0) || columns == 0 || !std::isfinite(t_end)) return 0;
   const std::size_t n = c_.signals;
   const Level* lv = &levels_.back();
   for (const auto& l : levels_)
@@ -114,27 +115,32 @@ std::size_t Decimator::view_f32(double t_end, double window_s, std::size_t colum
       break;
     }
   bucket_s = lv->width;
-  t0_s = t_end - window_s;
-  col_s = std::max(window_s / static_cast<double>(columns), lv->width);
-  const auto ncol = static_cast<std::size_t>(std::ceil(window_s / col_s));
+  // the grid: k buckets per column; the window's columns end with the one holding t_end
+  const auto k = std::max<std::int64_t>(
+      1, static_cast<std::int64_t>(std::ceil(window_s / static_cast<double>(columns) / lv->width - 1e-9)));
+  col_s = static_cast<double>(k) * lv->width;
+  const auto floor_div = [k](std::int64_t b) { return b >= 0 ? b / k : -((-b + k - 1) / k); };
+  const std::int64_t last = floor_div(static_cast<std::int64_t>(std::floor(t_end / lv->width)));
+  const std::int64_t first =
+      std::max(floor_div(static_cast<std::int64_t>(std::floor((t_end - window_s) / lv->width))), from_col);
+  t0_s = static_cast<double>(first) * col_s;
+  if (first > last) return 0;
+  const auto ncol = static_cast<std::size_t>(last - first + 1);
   const float nan = std::numeric_limits<float>::quiet_NaN();
   out.assign(signals.size() * 2 * ncol, nan);
   const auto nb = static_cast<std::int64_t>(c_.buckets);
   for (std::size_t c = 0; c < ncol; ++c) {
-    const double a = t0_s + static_cast<double>(c) * col_s;
-    const auto b0 = static_cast<std::int64_t>(std::floor(a / lv->width));
-    auto b1 = static_cast<std::int64_t>(std::floor((a + col_s) / lv->width));
-    if (b1 <= b0) b1 = b0 + 1;
-    for (std::int64_t b = b0; b < b1; ++b) {
+    const std::int64_t b0 = (first + static_cast<std::int64_t>(c)) * k;
+    for (std::int64_t b = b0; b < b0 + k; ++b) {
       const auto slot = static_cast<std::size_t>(((b % nb) + nb) % nb);
       if (lv->index[slot] != b) continue;
       const double* lo = &lv->lo[slot * n];
       const double* hi = &lv->hi[slot * n];
-      for (std::size_t k = 0; k < signals.size(); ++k) {
-        const std::size_t s = signals[k];
+      for (std::size_t q = 0; q < signals.size(); ++q) {
+        const std::size_t s = signals[q];
         if (s >= n) continue;
-        float& m = out[(2 * k) * ncol + c];
-        float& M = out[(2 * k + 1) * ncol + c];
+        float& m = out[(2 * q) * ncol + c];
+        float& M = out[(2 * q + 1) * ncol + c];
         const auto l = static_cast<float>(lo[s]), h = static_cast<float>(hi[s]);
         m = std::isnan(m) ? l : std::min(m, l);
         M = std::isnan(M) ? h : std::max(M, h);

@@ -181,12 +181,17 @@ Server::Server(ConsoleOptions options, Tuner tuner)
   // The decimated window, binary (little-endian): 64 bytes of header ("LSH1", u32 columns,
   // u32 signals, u32 0, f64 t_end, t0, column width, bucket width [s], samples, drops), then
   // per signal asked for (sig=i,j,..; default all) `columns` float32 minima, then maxima.
+  // Columns lie on a fixed grid (Decimator::view_f32): from=J sends only the window's columns
+  // from index J on (the page's incremental stream: J = its newest column, partial, minus a
+  // margin), t0 / column width = the first one's index.
   h.Get("/api/frame", [this, api_ok, common](const httplib::Request& req, httplib::Response& res) {
     if (!api_ok(req, res, false)) return;
     double window = 10.0;
     std::size_t columns = 800;
     std::vector<std::size_t> sig;
+    std::int64_t from = Decimator::kWholeWindow;
     try {
+      if (req.has_param("from")) from = std::stoll(req.get_param_value("from"));
       if (req.has_param("window")) window = std::stod(req.get_param_value("window"));
       if (req.has_param("columns")) columns = std::stoul(req.get_param_value("columns"));
       if (req.has_param("sig")) {
@@ -218,7 +223,7 @@ Server::Server(ConsoleOptions options, Tuner tuner)
         for (; k < sig.size() && sig[k] < first + g->dec.config().signals; ++k) local.push_back(sig[k] - first);
         first += g->dec.config().signals;
         if (local.empty()) continue;
-        ncol = g->dec.view_f32(t_end, window, columns, local, part, t0, col, bucket);
+        ncol = g->dec.view_f32(t_end, window, columns, local, part, t0, col, bucket, from);
         mm.insert(mm.end(), part.begin(), part.end());
       }
       samples = static_cast<double>(groups_.front()->dec.samples());

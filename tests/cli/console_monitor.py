@@ -15,8 +15,6 @@ Skips (77) when chromium, its driver or selenium is missing. LASH_CONSOLE_SHOT=F
 import json
 import math
 import os
-import re
-import shutil
 import struct
 import subprocess
 import sys
@@ -27,18 +25,9 @@ import urllib.request
 
 LASH = os.environ.get("LASH", "lash")
 SRC = os.environ.get("LASH_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
-CHROMIUM = shutil.which("chromium")
-DRIVER = shutil.which("chromedriver") or "/usr/bin/chromedriver"
-try:
-    from selenium import webdriver
-    from selenium.webdriver.chrome.service import Service
-    from selenium.webdriver.common.by import By
-except ImportError:
-    print("SKIP: python3-selenium is not installed")
-    sys.exit(77)
-if not CHROMIUM or not os.path.exists(DRIVER):
-    print("SKIP: chromium or chromium-driver is not installed")
-    sys.exit(77)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import browser  # noqa: E402  (the shared headless chromium; exits 77 when it is missing)
+from browser import By  # noqa: E402
 DBC = os.path.join(SRC, "config", "monitor", "hydraulic_bench_kpa.dbc")
 DT, DURATION, GAP_AT, GAP = 0.005, 26.0, 12.0, 1.5
 
@@ -91,18 +80,11 @@ with tempfile.TemporaryDirectory() as tmp:
         line = run.stderr.readline()
         if not line:
             fail("no console URL printed: " + run.stderr.read()[-500:])
-        m = re.search(r"lash console: (http://127\.0\.0\.1:(\d+)/\?token=([0-9a-f]{32}))$", line.strip())
-    url, port, token = m.group(1), m.group(2), m.group(3)
+        m = browser.lash_url(line)
+    url, port, token = m
     t_start = time.time()
     base = f"http://127.0.0.1:{port}"
-    o = webdriver.ChromeOptions()
-    o.binary_location = CHROMIUM
-    for a in ["--headless", "--no-sandbox", "--disable-gpu", "--no-first-run", "--disable-background-networking",
-              "--disable-component-update", "--disable-sync", "--disable-dev-shm-usage",
-              f"--user-data-dir={os.path.join(tmp, 'profile')}", "--window-size=1400,1100"]:
-        o.add_argument(a)
-    o.set_capability("goog:loggingPrefs", {"browser": "ALL"})
-    d = webdriver.Chrome(service=Service(DRIVER), options=o)
+    d = browser.chrome(os.path.join(tmp, "profile"))
     status = lambda: d.execute_script("const o = {}; document.querySelectorAll('[data-status]').forEach("
                                       "(e) => o[e.getAttribute('data-status')] = e.textContent); return o;")
     try:
@@ -150,7 +132,7 @@ with tempfile.TemporaryDirectory() as tmp:
                 fail("want 403")
         if os.environ.get("LASH_CONSOLE_SHOT"):
             d.save_screenshot(os.environ["LASH_CONSOLE_SHOT"])
-        errors = [e for e in d.get_log("browser") if e.get("level") == "SEVERE"]
+        errors = browser.severe_errors(d)
         if errors:
             fail(f"console errors in the page: {errors[:3]}")
         print("no console errors")

@@ -39,13 +39,19 @@ TEST(ConsoleDecimator, ViewF32EqualsNaiveMinMaxPerColumn) {
     const std::size_t ncol = d.view_f32(d.last_t(), window, 200, sig, out, t0, col, bucket);
     ASSERT_GT(ncol, 0u);
     ASSERT_EQ(out.size(), 3 * 2 * ncol);
-    // naive: a sample belongs to column c when its bucket start lies in [t0 + c col, t0 + (c+1) col)
-    // (columns are whole buckets: col is a multiple of the bucket width)
+    // the grid: a column is a whole number of buckets, t0 a whole number of columns, the window
+    // covered (the last column holds t_end)
+    const double k = col / bucket, j0 = t0 / col;
+    ASSERT_NEAR(k, std::round(k), 1e-9);
+    ASSERT_NEAR(j0, std::round(j0), 1e-6);
+    ASSERT_GE(col, window / 200 - 1e-12);
+    ASSERT_LE(t0, d.last_t() - window + 1e-9);
+    ASSERT_GT(t0 + col, d.last_t() - window);
+    ASSERT_GT(t0 + static_cast<double>(ncol) * col, d.last_t());
+    // naive: a sample belongs to column c when its bucket lies in [t0 + c col, t0 + (c+1) col)
     for (std::size_t cc = 0; cc < ncol; ++cc) {
-      const double a = t0 + static_cast<double>(cc) * col;
-      const auto b0 = static_cast<std::int64_t>(std::floor(a / bucket));
-      auto b1 = static_cast<std::int64_t>(std::floor((a + col) / bucket));
-      if (b1 <= b0) b1 = b0 + 1;
+      const auto b0 = std::llround(j0 + static_cast<double>(cc)) * std::llround(k);
+      const auto b1 = b0 + std::llround(k);
       for (std::size_t s = 0; s < 3; ++s) {
         double lo = NAN, hi = NAN;
         for (const auto& r : rows) {
@@ -69,6 +75,43 @@ TEST(ConsoleDecimator, ViewF32EqualsNaiveMinMaxPerColumn) {
       EXPECT_EQ(top, 1000.0f);
     }
   }
+}
+
+// The page's stream: asking from column J gives the columns J.. of the full view, equal to them.
+TEST(ConsoleDecimator, FromColumnIsTheTailOfTheWholeWindow) {
+  DecimatorConfig c;
+  c.signals = 2;
+  c.base_s = 0.001;
+  Decimator d(c);
+  std::uint64_t x = 11;
+  for (std::uint64_t k = 0; k < 12000; ++k) {
+    const double v[2] = {synthetic_value(0, k, 1000.0, x), synthetic_value(3, k, 1000.0, x)};
+    d.add(static_cast<double>(k) * 0.001, v);
+  }
+  const std::vector<std::size_t> sig{0, 1};
+  std::vector<float> all, part;
+  double t0 = 0, col = 0, bucket = 0, t0p = 0, colp = 0, bucketp = 0;
+  const std::size_t n = d.view_f32(d.last_t(), 10.0, 625, sig, all, t0, col, bucket);
+  EXPECT_EQ(bucket, 0.016);  // finest level covering 10 s: 1 ms * 4^2 (2048 buckets)
+  EXPECT_EQ(col, 0.016);
+  // columns 124 (holds 11.999 - 10 = 1.999 s: 1.999 / 0.016 = 124.9) to 749 (11.999 / 0.016 = 749.9)
+  EXPECT_EQ(n, 626u);
+  const auto j0 = std::llround(t0 / col);
+  EXPECT_EQ(j0, 124);
+  for (const std::int64_t back : {0, 1, 5, 625}) {
+    const std::int64_t from = j0 + 625 - back;
+    const std::size_t m = d.view_f32(d.last_t(), 10.0, 625, sig, part, t0p, colp, bucketp, from);
+    ASSERT_EQ(m, static_cast<std::size_t>(back + 1));
+    EXPECT_EQ(std::llround(t0p / colp), from);
+    for (std::size_t q = 0; q < 4; ++q)  // min, max of both signals
+      for (std::size_t cc = 0; cc < m; ++cc) {
+        const float a = all[q * n + (n - m) + cc], b = part[q * m + cc];
+        EXPECT_TRUE(a == b || (std::isnan(a) && std::isnan(b))) << "from " << from << " column " << cc;
+      }
+  }
+  // a column after the newest: nothing; before the window: the whole window
+  EXPECT_EQ(d.view_f32(d.last_t(), 10.0, 625, sig, part, t0p, colp, bucketp, j0 + 626), 0u);
+  EXPECT_EQ(d.view_f32(d.last_t(), 10.0, 625, sig, part, t0p, colp, bucketp, j0 - 100), 626u);
 }
 
 TEST(ConsoleDecimator, NothingBeforeTheFirstSampleNorFromNaN) {

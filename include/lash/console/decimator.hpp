@@ -38,10 +38,19 @@ class Decimator {
   void add(double t_s, std::span<const double> values) noexcept;
   /// The window [t_end - window_s, t_end) in at most `columns` columns.
   DecimatedView view(double t_end, double window_s, std::size_t columns) const;
-  /// The same for the signals listed (indices < signals; others skipped), min/max as float.
+  /// Every column of the whole window (view_f32's from_col).
+  static constexpr std::int64_t kWholeWindow = INT64_MIN;
+  /// The window ending at t_end for the signals listed (indices < signals; others skipped),
+  /// min/max as float, on a fixed grid: column j covers [j col_s, (j + 1) col_s), col_s a whole
+  /// number of the level's buckets (>= window_s / columns), so a column once complete never
+  /// changes and a client can ask only for the columns it lacks. The columns returned are those
+  /// holding the window (the first holds t_end - window_s, the last t_end and may be partial:
+  /// ceil(window_s / col_s) or one more) from index from_col on
+  /// (kWholeWindow: all of them); t0_s = the first one's start (its index is t0_s / col_s).
   /// out: per listed signal, ncol minima then ncol maxima (NaN = empty column). Returns ncol.
   std::size_t view_f32(double t_end, double window_s, std::size_t columns, std::span<const std::size_t> signals,
-                       std::vector<float>& out, double& t0_s, double& col_s, double& bucket_s) const;
+                       std::vector<float>& out, double& t0_s, double& col_s, double& bucket_s,
+                       std::int64_t from_col = kWholeWindow) const;
   double last_t() const noexcept { return last_t_; }
   std::uint64_t samples() const noexcept { return samples_; }
   /// Bytes held (constant after construction).

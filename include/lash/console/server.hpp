@@ -3,7 +3,8 @@
 /// The live console (docs/console.md): an HTTP server (cpp-httplib) on its own thread that
 /// serves the page, the decimated signals, the status and the events, and takes calibration
 /// changes. Endpoints: GET /api/meta (signals, params), GET /api/frame (the decimated window as
-/// binary float32 min/max per column: the page asks for one per animation frame), GET
+/// binary float32 min/max per column on a fixed grid; from=J: only the columns from J on, the page's
+/// stream), GET
 /// /api/status (JSON: status, events and estimates since an id, params), POST /api/tune. It is fed through a Feed (a lock-free SPSC ring, feed.hpp) that its drain thread
 /// empties into a Decimator every 10 ms; the producer never waits for the console.
 ///
