@@ -76,8 +76,9 @@ struct AdaptationSettings {
 ///     ĉ(k) = v(k−1) − (y(k) + a1⁰·y(k−1)) / b1⁰            (valve; left edge as a magnitude),
 /// and an edge step Δc moves ĉ(k) by Δc at once (the recursive estimate instead swings through
 /// a transient: the old and new regimes mixed in one fit, 200 → 380 mA seen as a dip to 200).
-/// Carts: the gap pushing up is w(k−1) − y(k−1) on a sample of an up key, pushing down
-/// y(k−1) − w(k−1) on a down key (engaged, the carts are rigid; no reference needed).
+/// Carts: on a sample that updates the estimator (engaged, moving) the gap of the face in contact
+/// is |w(k−1) − y(k−1)|, the up face where w > y, the down face where w < y (the carts are
+/// rigid; no reference needed).
 /// The reference is the side's identified (a1, b1) once the gate used it (reason `adapting`) for
 /// warmup_s; from then on the test runs on every sample that updates the side, whether the gate
 /// adapts or not (a drift the compensator cannot follow is still detected). δ = allowance_ratio ×
@@ -615,12 +616,14 @@ class BacklashAdapter {
       return gates();
     }
     const double v = w >= 0.0 ? w + s_ : w - s_;
-    const std::uint64_t up = est_.updates(Side::right, true) + est_.updates(Side::left, true);
-    const std::uint64_t down = est_.updates(Side::right, false) + est_.updates(Side::left, false);
+    const std::uint64_t n = est_.updates(Side::right) + est_.updates(Side::left);
     est_.step(v, y1_);
-    // The update regressed y(k−1) on w(k−1): engaged, the gap is w − y pushing up, y − w down.
-    probe_.right = est_.updates(Side::right, true) + est_.updates(Side::left, true) != up ? w1_ - y1_ : kNone;
-    probe_.left = est_.updates(Side::right, false) + est_.updates(Side::left, false) != down ? y1_ - w1_ : kNone;
+    // The update regressed y(k−1) on w(k−1) (engaged, moving): the face in contact is the sign
+    // of w − y (a decelerating drive brakes the free cart on the other face than it pushed it).
+    const bool updated = est_.updates(Side::right) + est_.updates(Side::left) != n;
+    const double g = w1_ - y1_;
+    probe_.right = updated && g > 0.0 ? g : kNone;
+    probe_.left = updated && g < 0.0 ? -g : kNone;
     w1_ = w;
     y1_ = y;
     const double mid = 0.5 * (in_use.right - in_use.left);
@@ -637,8 +640,9 @@ class BacklashAdapter {
     gap_ = true;
   }
   AdaptationReason refine(Side, AdaptationReason r) const noexcept { return r; }
-  /// The gap of side s (right: pushing up, left: down) the last sample shows: w(k−1) − y(k−1) on
-  /// an update of an up key, y(k−1) − w(k−1) on a down key; NaN otherwise. No reference needed.
+  /// The gap of side s (right: pushing up, left: down) the last sample shows on an update of the
+  /// estimator: w(k−1) − y(k−1) when positive (up face), y(k−1) − w(k−1) when that is positive
+  /// (down face); NaN otherwise. No reference needed.
   double probe(Side s) const noexcept { return probe_[s]; }
   bool set_reference(Side) noexcept { return true; }
   const char* reason(Side s) const noexcept;
