@@ -170,7 +170,16 @@ PerSide<GateInput> DeadzoneAdapter::step(double v_applied, double y, const PerSi
   // The estimator's switching: v(k−1) beyond the guesses (the excitation record follows it).
   const double v1 = v1_;
   v1_ = v_applied;
+  const std::uint64_t n_r = est_.updates(Side::right), n_l = est_.updates(Side::left);
   est_.step(v_applied, y);
+  // The drift test's probe (DriftDetectSettings): the edge this sample shows under the reference.
+  for (const Side s : {Side::right, Side::left}) {
+    const bool updated = est_.updates(s) != (s == Side::right ? n_r : n_l);
+    const Reference& r = ref_[s];
+    probe_[s] = updated && r.b1 != 0.0 ? (s == Side::right ? 1.0 : -1.0) * (v1 - (y + r.a1 * y1_) / r.b1)
+                                       : std::numeric_limits<double>::quiet_NaN();
+  }
+  y1_ = y;
   if (!est_.warming_up()) {
     if (v1 > ecfg_.guess_right) exc_.right.add(v1);
     else if (v1 < ecfg_.guess_left) exc_.left.add(v1);

@@ -1,6 +1,7 @@
 // Summary, JSON and CSV of a campaign's results.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 #include <fmt/core.h>
@@ -9,6 +10,7 @@
 #include "lash/io/atomic_file.hpp"
 #include "lash/io/csv.hpp"
 #include "lash/experiments/sweep.hpp"
+#include "lash/metrics/error.hpp"
 
 namespace lash::sweep {
 namespace {
@@ -57,7 +59,18 @@ Summary summarize(const Campaign& c, const std::vector<RunResult>& results) {
     if (key(r.nrmse) > key(results[s.worst_index].nrmse)) s.worst_index = i;
     for (Side sd : {Side::right, Side::left}) {
       ++s.sides_total;
-      if (r.side[sd].identified) ++s.sides_identified;
+      if (r.side[sd].identified) {
+        ++s.sides_identified;
+        const SideResult& x = r.side[sd];
+        const auto& t = r.truth.side[sd];
+        double e = 0.0;  // the largest error; NaN (e.g. no τ from a1 <= 0) wins
+        for (const double x_e : {relative_error(x.gain, t.gain), relative_error(x.tau_s, t.tau_s), relative_error(x.c, t.c),
+                                 r.d_identified ? relative_error(r.d, r.truth.d) : 0.0})
+          e = (std::isnan(x_e) || x_e > e) ? x_e : e;
+        if (std::isnan(e)) e = std::numeric_limits<double>::infinity();
+        if (e <= c.param_tolerance) ++s.sides_within;
+        if (e > 0.20) ++s.sides_above_20;
+      }
     }
     if (r.side.right.identified && r.side.left.identified && r.side.left.c > r.side.right.c) ++s.unphysical_reported;
     const bool needs_d = c.rig.kind == rigs::RigKind::coupled_carts;
@@ -110,6 +123,11 @@ std::string summary_text(const Campaign& c, const Summary& s, const std::vector<
                      s.unphysical_reported);
   out += fmt::format("parameters within {} of the rig's true effective values: {}/{} runs with identified sides\n",
                      pct(s.param_tolerance), s.params_within, s.params_checked);
+  out += fmt::format("identified sides within {} of the true K, tau, c{}: {}/{} = {}; above 20 %: {}\n",
+                     pct(s.param_tolerance), c.rig.kind == rigs::RigKind::coupled_carts ? ", d" : "", s.sides_within,
+                     s.sides_identified,
+                     pct(s.sides_identified ? static_cast<double>(s.sides_within) / static_cast<double>(s.sides_identified) : 0.0),
+                     s.sides_above_20);
   return out;
 }
 
@@ -143,6 +161,8 @@ std::string summary_json(const Campaign& c, const Summary& s, const std::vector<
   j["param_tolerance"] = s.param_tolerance;
   j["params_checked"] = s.params_checked;
   j["params_within_tolerance"] = s.params_within;
+  j["sides_within_tolerance"] = s.sides_within;  // identified sides with K, tau, c (and d) within
+  j["sides_above_20pct"] = s.sides_above_20;
   return j.dump(2) + "\n";
 }
 

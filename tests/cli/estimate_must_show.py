@@ -9,7 +9,7 @@ authors' published Coulomb force. Outliers are injected here with numpy.
  - the same records with 0.2 % of the samples moved by +-100 sigma: same bounds, outliers counted;
  - deadzone edges and deadband widths scaled by 0.3 and by 2 (amplitude 600 and 1200): same bounds;
  - coupled carts, ideal model, position through a 0.1 um scale, deadband 2-8 mm, sine and triangle
-   at 2 and 5 rad/s: d within 5 %;
+   at 2, 3, 4 and 5 rad/s: d within 5 %;
  - EMPS with only the column mapping: Coulomb force within 5 % of 20.14 / 20.63 N (skipped without data);
  - sweep of E3 and E4 with no [estimator] table: at least 100 % and 97.0 % good runs;
  - --print-config -> --config gives the same result; options a model does not use exit 2;
@@ -157,7 +157,7 @@ with tempfile.TemporaryDirectory() as d:
     # coupled carts through a 0.1 um linear scale
     for dd in (0.002, 0.005, 0.008):
         for wave in ("sine", "triangle"):
-            for w in (2.0, 5.0):
+            for w in (2.0, 3.0, 4.0, 5.0):
                 path = os.path.join(d, f"cc_{dd}_{wave}_{w}.csv")
                 coupled_carts(path, dd, wave, w)
                 j = estimate(path, "coupled-carts")

@@ -204,6 +204,64 @@ TEST(DeadzoneCompensator, StaleSamplesNeitherUpdateTheEstimatorNorMoveTheInverse
   EXPECT_NE(estimator_state(comp.estimator()), estimator_state(all_fresh.estimator()));
 }
 
+// Drift events (DriftDetectSettings): the valve loop of the test above, every sample fresh, sensor
+// noise ±1 kPa, a first-order plant y(k) = 0.93 y(k−1) + 0.1505 DZ(i(k−1)) whose right edge steps
+// 288 → 380 mA at 30 s. No event before the step; the right edge's first event comes within 3 s,
+// with old and new the plant's two edges (the probe's mean before and after the change time).
+TEST(DeadzoneCompensator, DriftEventGivesTheEdgesBeforeAndAfterAStep) {
+  DeadzoneCompensationConfig cfg = valve(CompensationMode::adaptive);
+  cfg.estimator.dt_s = 0.005;
+  cfg.estimator.method = EstimationMethod::iv;
+  cfg.estimator.rls.lambda = 0.995;
+  DeadzoneCompensator comp(cfg);
+  Rng rng(5);
+  double x = 0.0, y = 0.0, i = 0.0, integ = 0.0;
+  for (int k = 0; k < 12000; ++k) {
+    const double edge = k < 6000 ? 288.0 : 380.0;
+    const double r = 600.0 * std::sin(2.0 * std::numbers::pi * k * 0.005 / 4.0);
+    y = x + 2.0 * (rng.uniform() - 0.5);
+    integ += 10.0 * 0.005 * (r - y);
+    i = std::clamp(comp.command(0.5 * (r - y) + integ + 0.465 * r), -2000.0, 2000.0);
+    comp.observe(i, y, true);
+    const double dz = i > edge ? i - edge : (i < -296.0 ? i + 296.0 : 0.0);
+    x = 0.93 * x + 0.07 * 2.15 * dz;
+  }
+  const AdaptationEvents& ev = comp.events();
+  const AdaptationEvent* first = nullptr;
+  for (std::uint32_t n = 0; n < ev.n; ++n) {
+    const AdaptationEvent& e = ev.events[n];
+    if (e.kind != AdaptationEvent::Kind::drift) continue;
+    EXPECT_GE(e.sample, 6000u) << "false alarm on side " << (e.side == Side::right ? "right" : "left");
+    if (!first && e.side == Side::right) first = &e;
+  }
+  ASSERT_NE(first, nullptr);
+  EXPECT_LE(first->sample, 6000u + 600u);
+  EXPECT_NEAR(first->old_value, 288.0, 2.0);
+  EXPECT_NEAR(first->new_value, 380.0, 2.0);
+  EXPECT_EQ(comp.drifts(Side::left), 0u);
+}
+
+// The carts' probe is the gap of the face in contact: a reference backlash whose up gap grows
+// 4 → 7 mm at 20 s gives one event on the right (up) gap, 4 → 7 mm, none on the down gap.
+TEST(BacklashCompensator, DriftEventGivesTheGapsBeforeAndAfterAStep) {
+  BacklashCompensator comp(carts(CompensationMode::adaptive));
+  RefBacklash b{0.004, 0.0065, -0.0065};
+  for (int k = 0; k < 40000; ++k) {
+    if (k == 20000) b.cr = 0.007;
+    const double w = 0.05 * std::sin(2.0 * std::numbers::pi * k * kDt / 4.0);
+    comp.observe(w, b.step(w), true);
+  }
+  ASSERT_GE(comp.events().n, 1u);
+  EXPECT_EQ(comp.drifts(Side::right), 1u);
+  EXPECT_EQ(comp.drifts(Side::left), 0u);
+  const AdaptationEvent& e = comp.events().events[0];
+  EXPECT_EQ(e.kind, AdaptationEvent::Kind::drift);
+  EXPECT_GE(e.sample, 20000u);
+  EXPECT_LE(e.sample, 23000u);
+  EXPECT_NEAR(e.old_value, 0.004, 1e-6);
+  EXPECT_NEAR(e.new_value, 0.007, 1e-6);
+}
+
 // The carts' adapter regresses the driven position one sample late: after a stale sample the
 // next one only refills that delay (the estimator is stepped from the sample after it on).
 TEST(BacklashCompensator, StaleSamplesRestartTheEstimatorAndHoldTheInverse) {

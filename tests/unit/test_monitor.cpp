@@ -34,6 +34,7 @@ TEST(PageHinkley, IncreaseByHand) {
   EXPECT_DOUBLE_EQ(ph.down_statistic(), 0.0);
   EXPECT_DOUBLE_EQ(ph.mean(), 1.0);
   EXPECT_DOUBLE_EQ(ph.mean_before(PageHinkley::Change::up), 0.0);
+  EXPECT_DOUBLE_EQ(ph.mean_after(PageHinkley::Change::up), 4.0);  // the one sample after the change time
 }
 
 // h = 3: at k=4 U − m = 2.5 (no alarm); k=5: x̄ = 8/5 = 1.6, U = 1.0 + (4 − 1.6 − 0.5) = 2.9,
@@ -43,6 +44,7 @@ TEST(PageHinkley, ThresholdByHand) {
   for (double x : {0.0, 0.0, 0.0, 4.0}) EXPECT_EQ(ph.update(x), PageHinkley::Change::none);
   EXPECT_EQ(ph.update(4), PageHinkley::Change::up);
   EXPECT_NEAR(ph.up_statistic(), 4.4, 1e-12);
+  EXPECT_DOUBLE_EQ(ph.mean_after(PageHinkley::Change::up), 4.0);  // (4 + 4)/2, samples 4 and 5
 }
 
 // x = 0, 0, 0, −4: the mirror image: L = 0.5, 1.0, 1.5, then x̄ = −1, L = 1.5 + (−4 + 1 + 0.5) = −1,
@@ -55,7 +57,9 @@ TEST(PageHinkley, DecreaseAndNaN) {
   EXPECT_EQ(ph.update(-4), PageHinkley::Change::down);
   EXPECT_DOUBLE_EQ(ph.down_statistic(), 2.5);
   EXPECT_DOUBLE_EQ(ph.mean_before(PageHinkley::Change::down), 0.0);
+  EXPECT_DOUBLE_EQ(ph.mean_after(PageHinkley::Change::down), -4.0);
   ph.reset();
+  EXPECT_TRUE(std::isnan(ph.mean_after(PageHinkley::Change::down)));
   EXPECT_EQ(ph.count(), 0u);
   EXPECT_THROW(PageHinkley({-1.0, 1.0}), std::invalid_argument);
   EXPECT_THROW(PageHinkley({0.0, 0.0}), std::invalid_argument);

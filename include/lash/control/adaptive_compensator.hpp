@@ -24,7 +24,9 @@
 ///          θ* = θ(k−1) within hold_s of the last valid sample, θ* = θ_nominal after that.
 /// Real time: command() and observe() are noexcept, O(1) and allocation-free.
 #include <array>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include "lash/blocks/backlash_inverse.hpp"
 #include "lash/blocks/deadzone_inverse.hpp"
@@ -67,19 +69,31 @@ struct AdaptationSettings {
 
 /// Change detection on each adapted parameter (docs/compensation.md "Drift events"): a two-sided
 /// Page–Hinkley test (metrics/page_hinkley.hpp: Page 1954; Basseville & Nikiforov 1993 §2.2.3)
-/// on the parameter's estimate against its running mean since the last alarm, fed on the samples
-/// where the gate uses the estimate (reason `adapting`: identified, plausible, excited, settled),
-/// after the first warmup_s of such samples of that side (the start-up transient of the estimate).
-/// δ = allowance_ratio × nominal; h = δ × delay_s / T: a change of 2δ sustained for delay_s
+/// on the parameter *as each sample shows it* under a frozen reference model — the residual
+/// approach to additive changes in a regression (Basseville & Nikiforov 1993, ch. 7): on a
+/// sample that updates side s, y(k) = −a1·y(k−1) + b1·(v(k−1) − c), so with the reference
+/// (a1⁰, b1⁰) of that side the sample's own edge is
+///     ĉ(k) = v(k−1) − (y(k) + a1⁰·y(k−1)) / b1⁰            (valve; left edge as a magnitude),
+/// and an edge step Δc moves ĉ(k) by Δc at once (the recursive estimate instead swings through
+/// a transient: the old and new regimes mixed in one fit, 200 → 380 mA seen as a dip to 200).
+/// Carts: on a sample that updates the estimator (engaged, moving) the gap of the face in contact
+/// is |w(k−1) − y(k−1)|, the up face where w > y, the down face where w < y (the carts are
+/// rigid; no reference needed).
+/// The reference is the side's identified (a1, b1) once the gate used it (reason `adapting`) for
+/// warmup_s; from then on the test runs on every sample that updates the side, whether the gate
+/// adapts or not (a drift the compensator cannot follow is still detected). δ = allowance_ratio ×
+/// nominal; h = δ × delay_s / T: a change of 2δ sustained for delay_s of the side's samples
 /// alarms. An alarm is a `drift` event (old = the mean before the estimated change time, new =
-/// the estimate now); the test then rests for rearm_s of adapting samples (the estimate's
-/// transient after a change) and starts again on the level it finds.
+/// the mean after it); the test then rests for rearm_s and starts again on the level it finds.
+/// The reference is kept: the test watches the edges and gaps, not a1 and b1 (a changed gain or
+/// time constant would give an operating-point-dependent probe; refreshing the reference from
+/// the recursive estimate after a drift gave repeated events, one per period of the sine).
 struct DriftDetectSettings {
   bool enabled = true;
   double allowance_ratio = 0.1;   ///< δ / nominal [-], > 0
   double delay_s = 0.25;          ///< a change of 2δ alarms after this long [s], > 0
   double warmup_s = 5.0;          ///< adapting time of a side before its test starts [s], >= 0
-  double rearm_s = 2.0;           ///< adapting time after an alarm before the test restarts [s], >= 0
+  double rearm_s = 2.0;           ///< time after an alarm before the test restarts [s], >= 0
   /// Throws std::invalid_argument naming the field.
   void validate() const;
 };
@@ -93,7 +107,7 @@ struct AdaptationEvent {
   ReguessRule rule = ReguessRule::none;  ///< reguess: out or in
   std::uint64_t sample = 0;              ///< observe() call (0-based; t = sample·T) [-]
   double old_value = 0.0;                ///< reguess: the guess before [v unit]; drift: the level before [parameter unit]
-  double new_value = 0.0;                ///< reguess: the new guess; drift: the estimate at the alarm
+  double new_value = 0.0;                ///< reguess: the new guess; drift: the level after the change
 };
 const char* to_string(AdaptationEvent::Kind k) noexcept;
 
@@ -231,6 +245,10 @@ struct CompensationConfig {
 ///   - restart() noexcept, a gap in the samples (observe(…, fresh = false)): the estimator's
 ///     restart() and the adapter's own sample history, estimates kept;
 ///   - refine(Side, AdaptationReason) noexcept, the adapter's own refusal (e.g. not_excited);
+///   - probe(Side) noexcept -> double, the gate parameter of side s as the last sample shows it
+///     under the reference model (NaN: the sample did not update that side, or no reference);
+///     set_reference(Side) noexcept -> bool, the side's identified model becomes the reference
+///     (false: not identified, nothing changes) — the drift test;
 ///   - reason(Side) noexcept -> const char*, why a side is (not) used;
 ///   - identified(Side) noexcept, the estimator's own verdict on a side;
 ///   - estimator() -> const Estimator&;
@@ -308,10 +326,8 @@ class Compensator {
       ++updates_;
     }
     if (cfg_.detect.enabled) {
-      if (gate_r_.reason() == AdaptationReason::adapting && ++adapting_.right > armed_at_.right)
-        detect(Side::right, e.right.value, k);
-      if (gate_l_.reason() == AdaptationReason::adapting && ++adapting_.left > armed_at_.left)
-        detect(Side::left, e.left.value, k);
+      watch(Side::right, gate_r_.reason() == AdaptationReason::adapting, k);
+      watch(Side::left, gate_l_.reason() == AdaptationReason::adapting, k);
     }
   }
   /// Re-guesses and drift events so far (the first AdaptationEvents::kCapacity).
@@ -415,13 +431,26 @@ class Compensator {
     const SideReguess& g = adapter_.reguess(s);
     events_.add({AdaptationEvent::Kind::reguess, s, g.last_rule(), k, g.last_old_guess(), g.guess()});
   }
-  void detect(Side s, double x, std::uint64_t k) noexcept {
+  /// One fresh sample of side s's drift test (DriftDetectSettings): warm-up on adapting samples,
+  /// then the Page–Hinkley test on the adapter's probe; after an alarm a rest of rearm_s.
+  void watch(Side s, bool adapting, std::uint64_t k) noexcept {
+    Watch& w = watch_[s];
+    if (!w.armed) {  // the reference must have been trusted by the gate for warmup_s
+      if (adapting && ++w.count >= warmup_n_ && adapter_.set_reference(s)) w.armed = true;
+      return;
+    }
+    if (w.rest > 0) {  // after an alarm: the test restarts on the level it finds after rearm_s
+      --w.rest;
+      return;
+    }
+    const double x = adapter_.probe(s);
+    if (!(x == x)) return;  // this sample did not update side s
     const PageHinkley::Change c = ph_[s].update(x);
     if (c == PageHinkley::Change::none) return;
-    events_.add({AdaptationEvent::Kind::drift, s, ReguessRule::none, k, ph_[s].mean_before(c), x});
+    events_.add({AdaptationEvent::Kind::drift, s, ReguessRule::none, k, ph_[s].mean_before(c), ph_[s].mean_after(c)});
     ++drifts_[s];
     ph_[s].reset();
-    armed_at_[s] = adapting_[s] + rearm_n_;
+    w.rest = rearm_n_;
   }
   void restart_from_nominal() noexcept {
     const PerSide<double> n = Adapter::nominal(cfg_.nominal);
@@ -442,10 +471,14 @@ class Compensator {
   PerSide<PageHinkley> ph_;
   AdaptationEvents events_;
   PerSide<std::uint64_t> drifts_{};
-  PerSide<std::uint64_t> adapting_{};  ///< samples each side's gate adapted (the detector's warm-up)
+  struct Watch {  ///< one side's drift test state (watch())
+    bool armed = false;
+    std::uint64_t count = 0;  ///< adapting samples before the test is armed
+    std::uint64_t rest = 0;   ///< samples of rest left after an alarm
+  };
+  PerSide<Watch> watch_{};
   std::uint64_t rearm_n_ = static_cast<std::uint64_t>(cfg_.detect.rearm_s / cfg_.estimator.dt_s);
-  PerSide<std::uint64_t> armed_at_ = PerSide<std::uint64_t>::both(
-      static_cast<std::uint64_t>(cfg_.detect.warmup_s / cfg_.estimator.dt_s));  ///< the test runs past this count
+  std::uint64_t warmup_n_ = static_cast<std::uint64_t>(cfg_.detect.warmup_s / cfg_.estimator.dt_s);
   std::uint64_t k_ = 0;  ///< observe() calls in adaptive mode
   std::uint64_t updates_ = 0, stale_ = 0;
   bool stepped_ = false;  ///< the adapter was stepped since it was built or last restarted
@@ -495,6 +528,16 @@ class DeadzoneAdapter {
   AdaptationReason refine(Side s, AdaptationReason r) const noexcept {
     return (not_excited_[s] && r == AdaptationReason::not_identified) ? AdaptationReason::not_excited : r;
   }
+  /// The edge magnitude of side s the last sample shows under the reference (a1⁰, b1⁰):
+  /// σ·(v(k−1) − (y(k) + a1⁰·y(k−1))/b1⁰), σ = +1 right, −1 left; NaN unless it updated side s.
+  double probe(Side s) const noexcept { return probe_[s]; }
+  /// Side s's identified (a1, b1) become the probe's reference; false when not identified.
+  bool set_reference(Side s) noexcept {
+    const SideParams p = est_.params(s);
+    if (!p.identified || !(std::fabs(p.b1) > 1e-12)) return false;
+    ref_[s] = {p.a1, p.b1};
+    return true;
+  }
   const char* reason(Side s) const noexcept;
   /// The estimator's own verdict on side s (update-time checks 1–5).
   bool identified(Side s) const noexcept { return est_.params(s).identified; }
@@ -507,7 +550,13 @@ class DeadzoneAdapter {
   PerSide<detail::Excitation> exc_;
   Reguesser rg_;
   double v1_ = 0.0;
+  double y1_ = 0.0;  ///< y of the last sample (the probe's y(k−1))
   PerSide<bool> not_excited_{};
+  struct Reference {
+    double a1 = 0.0, b1 = 0.0;  ///< b1 = 0: none yet
+  };
+  PerSide<Reference> ref_{};
+  PerSide<double> probe_ = PerSide<double>::both(std::numeric_limits<double>::quiet_NaN());
 };
 
 /// Settings of the carts' estimator: lash's deadzone-deadband estimator (identify/estimators.hpp)
@@ -562,10 +611,20 @@ class BacklashAdapter {
     if (gap_) {  // after restart(): y1_ is from before the gap; this sample only refills it
       gap_ = false;
       y1_ = y;
+      w1_ = w;
+      probe_ = PerSide<double>::both(kNone);
       return gates();
     }
     const double v = w >= 0.0 ? w + s_ : w - s_;
+    const std::uint64_t n = est_.updates(Side::right) + est_.updates(Side::left);
     est_.step(v, y1_);
+    // The update regressed y(k−1) on w(k−1) (engaged, moving): the face in contact is the sign
+    // of w − y (a decelerating drive brakes the free cart on the other face than it pushed it).
+    const bool updated = est_.updates(Side::right) + est_.updates(Side::left) != n;
+    const double g = w1_ - y1_;
+    probe_.right = updated && g > 0.0 ? g : kNone;
+    probe_.left = updated && g < 0.0 ? -g : kNone;
+    w1_ = w;
     y1_ = y;
     const double mid = 0.5 * (in_use.right - in_use.left);
     rg_.follow(est_, v1_, {s_ + mid, -s_ + mid});
@@ -581,6 +640,11 @@ class BacklashAdapter {
     gap_ = true;
   }
   AdaptationReason refine(Side, AdaptationReason r) const noexcept { return r; }
+  /// The gap of side s (right: pushing up, left: down) the last sample shows on an update of the
+  /// estimator: w(k−1) − y(k−1) when positive (up face), y(k−1) − w(k−1) when that is positive
+  /// (down face); NaN otherwise. No reference needed.
+  double probe(Side s) const noexcept { return probe_[s]; }
+  bool set_reference(Side) noexcept { return true; }
   const char* reason(Side s) const noexcept;
   bool identified(Side s) const noexcept { return est_.params(s).identified; }
   const Estimator& estimator() const noexcept { return est_; }
@@ -590,10 +654,12 @@ class BacklashAdapter {
     const SideParams r = est_.params(Side::right), l = est_.params(Side::left);
     return {{r.identified, r.d + (r.c - s_)}, {l.identified, l.d - (l.c + s_)}};
   }
+  static constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
   DeadzoneDeadbandEstimator est_;
   double s_;
   Reguesser rg_;
-  double y1_ = 0.0, v1_ = 0.0;
+  double y1_ = 0.0, v1_ = 0.0, w1_ = 0.0;
+  PerSide<double> probe_ = PerSide<double>::both(kNone);
   bool gap_ = false;
 };
 

@@ -100,6 +100,9 @@ struct Summary {
   std::size_t params_within = 0;  ///< … whose param_error ≤ tolerance
   double param_tolerance = 0.05;
   std::size_t sides_identified = 0, sides_total = 0;
+  /// Identified sides whose K, τ and c (coupled carts: and d, when identified) all lie within
+  /// param_tolerance of the rig's true effective values; and those with an error above 20 %.
+  std::size_t sides_within = 0, sides_above_20 = 0;
   std::size_t unphysical_reported = 0;  ///< identified sides with c_l > c_r (must be 0)
   /// Runs whose whole model was identified at the end (both sides; coupled carts: and d).
   std::size_t runs_identified = 0;

@@ -81,6 +81,15 @@ class PageHinkley {
     if (n == 0) return n_ == 0 ? std::numeric_limits<double>::quiet_NaN() : mean_;
     return sum / static_cast<double>(n);
   }
+  /// Mean of the samples after the estimated change time of `c` (the level the test moved to);
+  /// the running mean when the extremum is the start. NaN before a sample.
+  double mean_after(Change c) const noexcept {
+    const std::uint64_t n = c == Change::down ? down_n_ : up_n_;
+    const double sum = c == Change::down ? down_sum_ : up_sum_;
+    if (n_ == 0) return std::numeric_limits<double>::quiet_NaN();
+    if (n == 0 || n == n_) return mean_;
+    return (sum_ - sum) / static_cast<double>(n_ - n);
+  }
   const PageHinkleySettings& settings() const noexcept { return s_; }
 
  private:
