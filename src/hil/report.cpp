@@ -251,8 +251,8 @@ NodeFigures node_figures(const NodeStats& stats, const LoopTrace& loop) {
   return f;
 }
 
-void make_run_report(RunReport& rep, const MasterRun* master, const std::vector<SlaveRun>& slaves,
-                     const std::vector<MasterStepLog>& simulated, const BenchScenario* scenario) {
+void report_nodes(RunReport& rep, const MasterRun* master, const std::vector<SlaveRun>& slaves,
+                  const std::function<NodeFigures(const NodeStats&, const LoopTrace&, bool is_master)>& figures) {
   rep.have_master = master != nullptr;
   rep.have_slave = !slaves.empty();
   rep.frames = {};
@@ -264,19 +264,26 @@ void make_run_report(RunReport& rep, const MasterRun* master, const std::vector<
   };
   for (const auto& s : slaves) add(s.stats.frames);
   if (rep.have_slave) {
-    rep.slave = node_figures(slaves[0].stats, slaves[0].loop);
+    rep.slave = figures(slaves[0].stats, slaves[0].loop, false);
     rep.slave.recovered = rep.slave_recovered;
     rep.slave_events = slaves[0].events;
     rep.slave_state = slaves[0].stats.state;
   }
   if (!master) return;
   add(master->stats.frames);
-  rep.master = node_figures(master->stats, master->loop);
+  rep.master = figures(master->stats, master->loop, true);
   rep.master.recovered = rep.master_recovered;
   rep.handshake_s = master->stats.handshake_s;
   rep.control_steps = master->stats.control_steps;
   rep.events = master->events;
   rep.master_state = master->stats.state;
+}
+
+void make_run_report(RunReport& rep, const MasterRun* master, const std::vector<SlaveRun>& slaves,
+                     const std::vector<MasterStepLog>& simulated, const BenchScenario* scenario) {
+  report_nodes(rep, master, slaves,
+               [](const NodeStats& s, const LoopTrace& l, bool) { return node_figures(s, l); });
+  if (!master) return;
   rep.vs_simulation = compare_with_simulation(master->log, simulated);
   rep.off_schedule = off_schedule_steps(master->log, rep.have_slave ? slaves[0].log : std::vector<SlaveStepLog>{},
                                         rep.control_steps);

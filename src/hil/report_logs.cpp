@@ -297,35 +297,13 @@ void make_run_report_from_logs(RunReport& rep, const MasterRun* master, const st
                                const RunLogs& logs, const BenchLayout& L, const MasterConfig& mc,
                                const SlaveConfig& sc, const BenchScenario* scenario) {
   // make_run_report()'s figures.
-  rep.have_master = master != nullptr;
-  rep.have_slave = !slaves.empty();
-  rep.frames = {};
-  auto add = [&](const FrameStats& f) {
-    rep.frames.sent += f.sent;
-    rep.frames.received += f.received;
-    rep.frames.late += f.late;
-    rep.frames.lost += f.lost;
-  };
-  for (const auto& s : slaves) add(s.stats.frames);
-  if (rep.have_slave) {
-    rep.slave = figures_of(slaves[0].stats, slaves[0].loop, logs.slave);
-    rep.slave.recovered = rep.slave_recovered;
-    rep.slave_events = slaves[0].events;
-    rep.slave_state = slaves[0].stats.state;
-  }
+  report_nodes(rep, master, slaves, [&](const NodeStats& s, const LoopTrace& l, bool is_master) {
+    return figures_of(s, l, is_master ? logs.master : logs.slave);
+  });
   const std::filesystem::path* master_csv = master && logs.master ? &logs.master->file : nullptr;
   const std::filesystem::path* slave_csv = rep.have_slave && logs.slave ? &logs.slave->file : nullptr;
   const std::size_t slave_rows = slave_csv ? logs.slave->read.rows : 0;
-  if (!master) {
-    return;
-  }
-  add(master->stats.frames);
-  rep.master = figures_of(master->stats, master->loop, logs.master);
-  rep.master.recovered = rep.master_recovered;
-  rep.handshake_s = master->stats.handshake_s;
-  rep.control_steps = master->stats.control_steps;
-  rep.events = master->events;
-  rep.master_state = master->stats.state;
+  if (!master) return;
 
   const PairedFigures pf = paired_pass(master_csv, slave_csv, slave_rows, rep.control_steps, rep.step_s,
                                        rep.have_slave, rep.have_slave ? scenario : nullptr);

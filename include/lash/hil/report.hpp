@@ -5,6 +5,7 @@
 /// thesis (paper 2 §2.7.2: 90 % rise, 10 % settling, overshoot). Not real-time code.
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -208,6 +209,11 @@ struct RunReport {
   std::optional<LogRecovery> master_recovered, slave_recovered;  ///< a node killed: what its log kept
 };
 
+/// The nodes' part of `report` shared by make_run_report and make_run_report_from_logs: which
+/// nodes ran, the frame totals, and per node its figures (from `figures(stats, loop, is_master)`),
+/// recovery, events and end state; for the master also the handshake and the control steps.
+void report_nodes(RunReport& report, const MasterRun* master, const std::vector<SlaveRun>& slaves,
+                  const std::function<NodeFigures(const NodeStats&, const LoopTrace&, bool is_master)>& figures);
 /// Fills the computed part of `report` from the master's run, the slaves' runs (first = the one
 /// started with the master) and the simulation of the same control steps (simulate_bench).
 /// A run's `log` (and loop records) are what the session read back from the node's CSV log.
