@@ -35,14 +35,6 @@ a = ap.parse_args()
 import browser  # noqa: E402  (exits 77 without chromium / chromium-driver / python3-selenium)
 
 
-def rss_kb(pid):
-    with open(f"/proc/{pid}/status") as f:
-        for line in f:
-            if line.startswith("VmRSS:"):
-                return int(line.split()[1])
-    return -1
-
-
 def slope_per_min(ts, ys):
     n = len(ts)
     if n < 2:
@@ -87,7 +79,7 @@ with tempfile.TemporaryDirectory() as tmp:
             fps = (s["frames"] - last["frames"]) / (now - t_last)
             rdr = (s["draws"] - last["draws"]) / (now - t_last)
             last, t_last = s, now
-            r = rss_kb(run.pid)
+            r = browser.rss_kb(run.pid)
             samples.append((el, r, fps, rdr))
             print(f"{el:6.0f} s  VmRSS {r:7d} kB  window {w:>3} s  page {fps:5.1f} frames/s {rdr:5.1f} redraws/s",
                   flush=True)

@@ -54,3 +54,12 @@ def lash_url(line):
     """(url, port, token) of lash's "lash console: URL" line, or None."""
     m = URL_RE.search(line.strip())
     return (m.group(1), m.group(2), m.group(3)) if m else None
+
+
+def rss_kb(pid):
+    """The resident set [kB] of process `pid` (VmRSS of /proc/PID/status); -1 if absent."""
+    with open(f"/proc/{pid}/status") as f:
+        for line in f:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1])
+    return -1

@@ -39,14 +39,6 @@ def fail(msg):
     sys.exit(1)
 
 
-def rss_kb(pid):
-    with open(f"/proc/{pid}/status") as f:
-        for line in f:
-            if line.startswith("VmRSS:"):
-                return int(line.split()[1])
-    return -1
-
-
 def get(url, token):
     req = urllib.request.Request(url, headers={"X-Lash-Token": token})
     with urllib.request.urlopen(req, timeout=5) as r:
@@ -74,7 +66,7 @@ with tempfile.TemporaryDirectory() as tmp:
         d.get(url)
         while time.time() - t_start < 10:
             time.sleep(0.2)
-        rss10 = rss_kb(run.pid)
+        rss10 = browser.rss_kb(run.pid)
         scopes = [e.get_attribute("data-scope") for e in d.find_elements(By.CSS_SELECTOR, "[data-scope]")]
         print("scopes:", scopes)
         if len(scopes) != 4:
@@ -117,7 +109,7 @@ with tempfile.TemporaryDirectory() as tmp:
         fail("the plotted envelope is not the synthetic signals'")
     while run.poll() is None and time.time() - t_start < DURATION - 2:
         time.sleep(0.5)
-    rss_end = rss_kb(run.pid)
+    rss_end = browser.rss_kb(run.pid)
     print(f"server VmRSS: {rss10} kB at 10 s, {rss_end} kB at {time.time() - t_start:.0f} s "
           f"(growth {rss_end - rss10} kB, bound {MAX_GROWTH_KB} kB)")
     out, err = run.communicate(timeout=30)
