@@ -49,12 +49,7 @@ SimulationDiff compare_with_simulation(const std::vector<std::int64_t>& control_
     if (control_step[i] < 0) continue;
     const auto m = static_cast<std::size_t>(control_step[i]);
     if (m >= by_m.size() || by_m[m] == nullptr) continue;
-    ++d.compared;
-    const double dp = std::abs(measured_kPa[i] - by_m[m]->measured_kPa);
-    const double di = std::abs(current_mA[i] - by_m[m]->current_mA);
-    if ((dp > 0 || di > 0) && !d.first_diff_step) d.first_diff_step = control_step[i];
-    d.max_abs_diff_kPa = std::max(d.max_abs_diff_kPa, dp);
-    d.max_abs_diff_mA = std::max(d.max_abs_diff_mA, di);
+    d.add(control_step[i], measured_kPa[i], by_m[m]->measured_kPa, current_mA[i], by_m[m]->current_mA);
   }
   return d;
 }

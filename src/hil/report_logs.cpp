@@ -146,12 +146,7 @@ class StreamCompare {
     while (!rows_.done() && rows_.row().control_step < sim.control_step) rows_.advance();
     while (!rows_.done() && rows_.row().control_step == sim.control_step) {
       const MasterStepLog& e = rows_.row();
-      ++d_.compared;
-      const double dp = std::abs(e.measured_kPa - sim.measured_kPa);
-      const double di = std::abs(e.current_mA - sim.current_mA);
-      if ((dp > 0 || di > 0) && !d_.first_diff_step) d_.first_diff_step = e.control_step;
-      d_.max_abs_diff_kPa = std::max(d_.max_abs_diff_kPa, dp);
-      d_.max_abs_diff_mA = std::max(d_.max_abs_diff_mA, di);
+      d_.add(e.control_step, e.measured_kPa, sim.measured_kPa, e.current_mA, sim.current_mA);
       rows_.advance();
     }
   }

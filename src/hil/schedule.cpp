@@ -377,12 +377,7 @@ void TraceCompare::add(const MasterStepLog& sim) {
   const auto m = static_cast<double>(sim.control_step);
   while (t.have && t.v[0] < m) t.advance();
   while (t.have && t.v[0] == m) {
-    ++d_.compared;
-    const double dp = std::abs(t.v[1] - sim.measured_kPa);
-    const double di = std::abs(t.v[2] - sim.current_mA);
-    if ((dp > 0 || di > 0) && !d_.first_diff_step) d_.first_diff_step = sim.control_step;
-    d_.max_abs_diff_kPa = std::max(d_.max_abs_diff_kPa, dp);
-    d_.max_abs_diff_mA = std::max(d_.max_abs_diff_mA, di);
+    d_.add(sim.control_step, t.v[1], sim.measured_kPa, t.v[2], sim.current_mA);
     t.advance();
   }
 }

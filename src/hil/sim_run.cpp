@@ -85,12 +85,7 @@ SimulationFileRun simulate_to_csv(const BenchLayout& layout, const MasterConfig&
         const auto m = static_cast<std::size_t>(l.control_step);
         if (m < compare_with->size() && (*compare_with)[m].control_step == l.control_step) {
           const MasterStepLog& e = (*compare_with)[m];
-          ++diff.compared;
-          const double dp = std::abs(e.measured_kPa - l.measured_kPa);
-          const double di = std::abs(e.current_mA - l.current_mA);
-          if ((dp > 0 || di > 0) && !diff.first_diff_step) diff.first_diff_step = l.control_step;
-          diff.max_abs_diff_kPa = std::max(diff.max_abs_diff_kPa, dp);
-          diff.max_abs_diff_mA = std::max(diff.max_abs_diff_mA, di);
+          diff.add(l.control_step, e.measured_kPa, l.measured_kPa, e.current_mA, l.current_mA);
         }
       });
   if (compare_with) run.vs_log = diff;

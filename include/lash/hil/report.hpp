@@ -3,6 +3,8 @@
 /// What `lash hil run` reports from the nodes' logs: the emulated trace against the
 /// simulation through the same step functions, and the step-response figures of the
 /// thesis (paper 2 §2.7.2: 90 % rise, 10 % settling, overshoot). Not real-time code.
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -37,6 +39,15 @@ struct SimulationDiff {
   double max_abs_diff_kPa = 0.0;          ///< max |measured_emulated − measured_simulated|
   double max_abs_diff_mA = 0.0;           ///< max |current_emulated − current_simulated|
   std::optional<std::int64_t> first_diff_step;  ///< first control step where they differ
+  /// One control step compared: the emulated and the simulated pressure [kPa] and current [mA].
+  void add(std::int64_t control_step, double kPa_emulated, double kPa_simulated, double mA_emulated,
+           double mA_simulated) noexcept {
+    ++compared;
+    const double dp = std::abs(kPa_emulated - kPa_simulated), di = std::abs(mA_emulated - mA_simulated);
+    if ((dp > 0 || di > 0) && !first_diff_step) first_diff_step = control_step;
+    max_abs_diff_kPa = std::max(max_abs_diff_kPa, dp);
+    max_abs_diff_mA = std::max(max_abs_diff_mA, di);
+  }
 };
 /// Compares emulated master rows (control_step ≥ 0) with the simulation's, by control step.
 SimulationDiff compare_with_simulation(const std::vector<std::int64_t>& control_step,
