@@ -352,6 +352,23 @@ void tune_to_data(EstimatorConfig& c, const DataTraits& d) {
   with_model(c.model, [&]<class Model>() { Model::tune(c, d); });  // identify/models/
 }
 
+void gate_outliers(std::span<const double> y, double gate, std::vector<std::size_t>& rows,
+                   std::vector<double>& values) {
+  if (!(gate > 0.0)) return;
+  OutlierGateConfig gc;
+  gc.gate = gate;
+  OutlierGate gate_y(gc);
+  for (std::size_t k = 0; k < y.size(); ++k) {
+    const std::uint64_t before = gate_y.rejected();
+    const double g = gate_y.step(y[k]);
+    if (gate_y.rejected() == before) continue;  // accepted: g is y[k]
+    const double next = k + 1 < y.size() ? y[k + 1] : g;
+    if (std::fabs(next - y[k]) < std::fabs(next - g)) continue;  // a true step: y[k] stays
+    rows.push_back(k);
+    values.push_back(g);
+  }
+}
+
 AutoRun estimate_auto(const EstimatorConfig& cfg0, std::span<const double> v, std::span<const double> y,
                       const AutoOptions& o) {
   AutoRun out;
@@ -361,20 +378,7 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, std::span<const double> v, st
   // The replaced samples are kept apart from y (YEdits): no copy of the record.
   std::vector<std::size_t> edit_rows;
   std::vector<double> edit_values;
-  if (o.gate > 0.0) {
-    OutlierGateConfig gc;
-    gc.gate = o.gate;
-    OutlierGate gate_y(gc);
-    for (std::size_t k = 0; k < y.size(); ++k) {
-      const std::uint64_t before = gate_y.rejected();
-      const double g = gate_y.step(y[k]);
-      if (gate_y.rejected() == before) continue;  // accepted: g is y[k]
-      const double next = k + 1 < y.size() ? y[k + 1] : g;
-      if (std::fabs(next - y[k]) < std::fabs(next - g)) continue;  // a true step: y[k] stays
-      edit_rows.push_back(k);
-      edit_values.push_back(g);
-    }
-  }
+  gate_outliers(y, o.gate, edit_rows, edit_values);
   out.outliers = edit_rows.size();
   const YEdits edits{edit_rows, edit_values};
   out.cfg = cfg0;

@@ -59,18 +59,10 @@ void OnlineEstimator::init() {
     if (search_r || search_l) {
       // the guesses estimate_auto would search on this stretch (y through the same gate)
       std::vector<double> yc(by_);
-      if (s_.outlier_gate > 0.0) {
-        OutlierGateConfig gc;
-        gc.gate = s_.outlier_gate;
-        OutlierGate g(gc);
-        for (std::size_t k = 0; k < yc.size(); ++k) {
-          const std::uint64_t before = g.rejected();
-          yc[k] = g.step(by_[k]);
-          if (g.rejected() == before) continue;
-          const double next = k + 1 < yc.size() ? by_[k + 1] : yc[k];
-          if (std::fabs(next - by_[k]) < std::fabs(next - yc[k])) yc[k] = by_[k];
-        }
-      }
+      std::vector<std::size_t> rows;
+      std::vector<double> values;
+      gate_outliers(by_, s_.outlier_gate, rows, values);
+      for (std::size_t i = 0; i < rows.size(); ++i) yc[rows[i]] = values[i];
       const auto g = search_guesses(cfg, bv_, yc, smp.gap_rows);
       if (search_r) cfg.guess_right = g[0];
       if (search_l) cfg.guess_left = g[1];

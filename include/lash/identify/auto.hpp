@@ -106,6 +106,13 @@ AutoRun estimate_auto(const EstimatorConfig& cfg, std::span<const double> v, std
 AutoRun estimate_auto(const EstimatorConfig& cfg, std::span<const double> v, std::span<const double> y,
                       bool keep_trace = false, double gate = 12.0, std::span<const std::size_t> gap_rows = {});
 
+/// The outlier gate of estimate_auto over a whole record: the causal gate (auto_gate.hpp,
+/// threshold `gate`, 0 = off), except that a flagged sample whose successor lies nearer it than
+/// the gate's value is kept (the output really stepped there, a square-wave input). Appends the
+/// replaced rows (ascending) and their values to `rows` and `values` (YEdits' parts).
+void gate_outliers(std::span<const double> y, double gate, std::vector<std::size_t>& rows,
+                   std::vector<double>& values);
+
 /// The switching guesses estimate_auto would use on this record ({c_r*, c_l*}); for the sweep,
 /// which runs its estimator online on a rig whose open-loop record it can take first.
 /// `y_edits`: samples of y read from elsewhere (YEdits); `traits`: analyse_record of (v, y with
