@@ -19,6 +19,7 @@
 #include "lash/hil/schedule.hpp"
 #include "lash/hil/sim_run.hpp"
 #include "lash/io/error.hpp"
+#include "hil_test_bench.hpp"
 #include "recorded_dto.hpp"
 
 using namespace lash;
@@ -26,28 +27,9 @@ using namespace lash::hil;
 
 namespace {
 
-constexpr double kT = 0.005;
-
-MasterConfig master_cfg() {
-  MasterConfig m;
-  m.controller.pid.dt_s = kT;
-  m.controller.pid.gains.kp = 1.2;
-  m.controller.pid.gains.ki_per_s = 12.0;
-  m.controller.pid.gains.kd_s = 0.004;
-  m.reference.kind = Waveform::square;  // levels held 1 s: a step the report finds
-  m.reference.amplitude = 400.0;
-  m.reference.offset = 900.0;
-  m.reference.frequency_rad_s = std::numbers::pi;
-  return m;
-}
-
-SlaveConfig slave_cfg() {
-  SlaveConfig s;
-  s.plant.dt_s = kT;
-  s.plant.seed = 7;
-  s.dto_reply = {test::recorded_dto()};
-  return s;
-}
+using test::kT;
+using test::master_cfg;
+using test::slave_cfg;
 
 std::filesystem::path temp_dir() {
   const auto d = std::filesystem::temp_directory_path() / ("lash_hil_report_logs_" + std::to_string(::getpid()));

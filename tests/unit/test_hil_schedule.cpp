@@ -12,6 +12,7 @@
 #include "lash/hil/report.hpp"
 #include "lash/hil/schedule.hpp"
 #include "lash/io/error.hpp"
+#include "hil_test_bench.hpp"
 #include "recorded_dto.hpp"
 
 using namespace lash;
@@ -21,28 +22,9 @@ namespace {
 
 using test::recorded_dto;
 
-constexpr double kT = 0.005;
-
-MasterConfig master_cfg() {
-  MasterConfig m;
-  m.controller.pid.dt_s = kT;
-  m.controller.pid.gains.kp = 1.2;
-  m.controller.pid.gains.ki_per_s = 12.0;
-  m.controller.pid.gains.kd_s = 0.004;
-  m.reference.kind = Waveform::square;
-  m.reference.amplitude = 400.0;
-  m.reference.offset = 900.0;
-  m.reference.frequency_rad_s = std::numbers::pi;
-  return m;
-}
-
-SlaveConfig slave_cfg() {
-  SlaveConfig s;
-  s.plant.dt_s = kT;
-  s.plant.seed = 7;
-  s.dto_reply = {recorded_dto()};
-  return s;
-}
+using test::kT;
+using test::master_cfg;
+using test::slave_cfg;
 
 /// The bench's closed loop written out over an in-process link (MemLink), independent of the
 /// schedule replay: the master's CONNECT step, then each period slave.step(); master.step().
