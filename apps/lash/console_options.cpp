@@ -212,7 +212,7 @@ void slave_log_tail(const std::filesystem::path& csv, double step_s, console::Se
       server.set_status_text("slave_state", name);
     }
   };
-  server.set_status_text("slave_log", "waiting for " + csv.filename().string());
+  server.set_status_text("slave_log", "waiting for the first sensor frame and DAQ sample (the time base)");
   constexpr std::size_t kChunk = 64 * 1024;  // about 800 rows, a fifth of the feed's ring
   while (!stop.load()) {
     bool more = false;
@@ -223,6 +223,7 @@ void slave_log_tail(const std::filesystem::path& csv, double step_s, console::Se
       }
       const std::uint64_t before = tail.offset();
       tail.poll(on_line, kChunk);
+      if (!tail.opened()) server.set_status_text("slave_log", "waiting for " + csv.filename().string());
       more = tail.offset() - before >= kChunk;
       server.set_status("slave_log_rows", static_cast<double>(rows));
     }
