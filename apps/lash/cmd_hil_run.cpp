@@ -152,7 +152,7 @@ int run_run(const RunOptions& o) {
   std::unique_ptr<HilConsole> con;  // bound here, in the host's network namespace
   if (o.console.enabled()) {
     if (!so.xcp) throw InputError("", 0, "--console", "needs the master's XCP slave (not --xcp off)");
-    con = std::make_unique<HilConsole>(o.console, so.settings);
+    con = std::make_unique<HilConsole>(o.console, so.settings, o.out_dir);
     so.on_nodes_started = [&con] { con->start(); };
   }
   hil::install_session_signal_handlers();

@@ -2,10 +2,13 @@
 #include "console_options.hpp"
 
 #include <atomic>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <string>
+#include <string_view>
 #include <thread>
 
 #include <fmt/core.h>
@@ -16,6 +19,7 @@
 #include "lash/hil/nodes.hpp"
 #include "lash/hil/xcp_server.hpp"
 #include "lash/io/error.hpp"
+#include "lash/io/line_tail.hpp"
 #include "lash/rigs/pilot_valve_model.hpp"
 
 #ifndef LASH_UPLOT_DIR
@@ -69,8 +73,18 @@ namespace {
 const std::vector<std::string> kSlaveSignals{"slave_step", "slave_pilot_raw", "slave_measured_kPa",
                                              "slave_current_mA", "slave_command_counter"};
 
+/// steady_s() - k * step_s for the slave's step k: the earliest over every sensor frame seen (its
+/// Sensor_Counter unwrapped from 2^bits to the step), NaN before the first one. The slave sends
+/// the frame of step k during step k, so this is the slave's step-0 release plus the smallest
+/// send-to-arrival delay seen; slave_log_tail puts the log's rows on the tap's clock with it.
+void note_slave_origin(std::atomic<double>& origin, double a) {
+  double cur = origin.load();
+  while ((std::isnan(cur) || a < cur) && !origin.compare_exchange_weak(cur, a)) {
+  }
+}
+
 void slave_tap(const hil::BenchSettings& s, const hil::BenchLayout& L, console::Server& server,
-               const console::XcpBridge& bridge, const std::atomic<bool>& stop) {
+               const console::XcpBridge& bridge, const std::atomic<bool>& stop, std::atomic<double>& origin) {
   std::unique_ptr<can::Bus> bus;
   try {
     bus = can::open_bus(s.bus);
@@ -84,9 +98,23 @@ void slave_tap(const hil::BenchSettings& s, const hil::BenchLayout& L, console::
   smp.count = static_cast<std::uint32_t>(kSlaveSignals.size());
   for (auto& v : smp.values) v = std::nan("");
   std::uint64_t frames = 0;
+  const std::uint32_t bits = L.sensor_counter_bits();
+  const std::uint64_t modulus = std::uint64_t{1} << bits;
+  bool have_counter = false;
+  std::uint64_t step = 0;  // the last sensor frame's counter, unwrapped
   while (!stop.load()) {
     const auto f = bus->receive(std::chrono::milliseconds(50));
     if (!f) continue;
+    if (f->id == L.sensors_id) {
+      const std::uint64_t c = L.unpack_sensors(*f).counter;
+      if (!have_counter) {
+        step = c;
+        have_counter = true;
+      } else {
+        step += (c - (step % modulus) + modulus) % modulus;  // frames arrive in order on one bus
+      }
+      note_slave_origin(origin, console::steady_s() - static_cast<double>(step) * s.step_s);
+    }
     const double off = bridge.ecu_time_offset_s();
     if (std::isnan(off)) continue;
     if (f->id == L.sensors_id) {
@@ -104,6 +132,104 @@ void slave_tap(const hil::BenchSettings& s, const hil::BenchLayout& L, console::
     if (++frames % 200 == 0) server.set_status("slave_frames", static_cast<double>(frames));
   }
 }
+/// The slave's own log as it grows (feed 2): the columns of <out-dir>/slave.csv that do not cross
+/// the bus, as slave_log_<column>. Time: step k at origin + k * step_s, moved onto the master's
+/// DAQ clock like the tap's signals (the bridge's offset). Rows are read only once both are known
+/// (from the file's start, so none is lost); the status shows the slave's state by name.
+const std::vector<std::string> kSlaveLogColumns{"step",   "state", "command_fresh", "dropped", "pressure_kPa",
+                                                "tet_us", "io_us", "wake_latency_us"};
+
+std::vector<std::string> slave_log_signals() {
+  std::vector<std::string> v;
+  for (const auto& c : kSlaveLogColumns) v.push_back("slave_log_" + c);
+  return v;
+}
+
+void slave_log_tail(const std::filesystem::path& csv, double step_s, console::Server& server,
+                    const console::XcpBridge& bridge, const std::atomic<bool>& stop,
+                    const std::atomic<double>& origin) {
+  LineTail tail(csv);
+  std::vector<std::size_t> col;  // file column of each kSlaveLogColumns entry; empty: header not read
+  std::uint64_t restarts = 0, rows = 0, bad = 0;
+  std::size_t step_col = 0;
+  double last_state = std::nan("");
+  console::Sample smp;
+  smp.count = static_cast<std::uint32_t>(kSlaveLogColumns.size());
+  std::vector<std::string_view> fields;
+  auto split = [&fields](std::string_view line) {
+    fields.clear();
+    for (std::size_t p = 0;;) {
+      const std::size_t q = line.find(',', p);
+      fields.push_back(line.substr(p, q == std::string_view::npos ? std::string_view::npos : q - p));
+      if (q == std::string_view::npos) break;
+      p = q + 1;
+    }
+  };
+  auto on_line = [&](std::string_view line) {
+    split(line);
+    if (col.empty()) {  // the header
+      std::vector<std::size_t> c;
+      for (const auto& name : kSlaveLogColumns) {
+        std::size_t i = 0;
+        while (i < fields.size() && fields[i] != name) ++i;
+        if (i == fields.size()) {
+          server.set_status_text("slave_log", csv.filename().string() + ": no column '" + name + "'");
+          c.clear();
+          break;
+        }
+        c.push_back(i);
+      }
+      col = c;
+      if (!col.empty()) {
+        step_col = col[0];
+        server.set_status_text("slave_log", "following " + csv.filename().string());
+      }
+      return;
+    }
+    const double t0 = origin.load(), off = bridge.ecu_time_offset_s();
+    double step = std::nan("");
+    for (std::size_t j = 0; j < col.size(); ++j) {
+      double v = std::nan("");
+      if (col[j] < fields.size()) {
+        const auto f = fields[col[j]];
+        if (std::from_chars(f.data(), f.data() + f.size(), v).ec != std::errc{}) v = std::nan("");
+      }
+      smp.values[j] = v;
+      if (col[j] == step_col) step = v;
+    }
+    if (std::isnan(step)) {  // a damaged row: counted, not shown
+      server.set_status("slave_log_bad_rows", static_cast<double>(++bad));
+      return;
+    }
+    smp.t_s = t0 + step * step_s - off;
+    server.feed(2).push(smp);
+    ++rows;
+    const double state = smp.values[1];
+    if (!std::isnan(state) && state != last_state) {
+      const std::string name(hil::to_string(static_cast<hil::NodeState>(static_cast<int>(state))));
+      if (!std::isnan(last_state)) server.add_event(smp.t_s, "slave_state", name);
+      last_state = state;
+      server.set_status_text("slave_state", name);
+    }
+  };
+  server.set_status_text("slave_log", "waiting for the first sensor frame and DAQ sample (the time base)");
+  constexpr std::size_t kChunk = 64 * 1024;  // about 800 rows, a fifth of the feed's ring
+  while (!stop.load()) {
+    bool more = false;
+    if (!std::isnan(origin.load()) && !std::isnan(bridge.ecu_time_offset_s())) {
+      if (tail.restarts() != restarts) {  // the file was replaced: its header comes again
+        restarts = tail.restarts();
+        col.clear();
+      }
+      const std::uint64_t before = tail.offset();
+      tail.poll(on_line, kChunk);
+      if (!tail.opened()) server.set_status_text("slave_log", "waiting for " + csv.filename().string());
+      more = tail.offset() - before >= kChunk;
+      server.set_status("slave_log_rows", static_cast<double>(rows));
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(more ? 10 : 50));
+  }
+}
 }  // namespace
 
 struct HilConsole::Impl {
@@ -111,11 +237,14 @@ struct HilConsole::Impl {
   std::unique_ptr<console::Server> server;
   hil::BenchSettings settings;
   hil::BenchLayout layout;
+  std::filesystem::path slave_csv;
   std::atomic<bool> stop{false};
-  std::thread tap;
+  std::atomic<double> slave_origin{std::numeric_limits<double>::quiet_NaN()};
+  std::thread tap, log_tail;
 };
 
-HilConsole::HilConsole(const ConsoleArgs& a, const hil::BenchSettings& s) : impl_(std::make_unique<Impl>()) {
+HilConsole::HilConsole(const ConsoleArgs& a, const hil::BenchSettings& s, const std::filesystem::path& out_dir)
+    : impl_(std::make_unique<Impl>()) {
   const hil::BenchLayout L = hil::BenchLayout::from_dbc(s.dbc_file);
   console::XcpBridgeOptions bo;
   bo.bus = s.bus;
@@ -127,7 +256,8 @@ HilConsole::HilConsole(const ConsoleArgs& a, const hil::BenchSettings& s) : impl
   impl_->bridge = std::make_unique<console::XcpBridge>(bo);
   console::ConsoleOptions co = console_options(a, "lash hil run (master, measured over XCP DAQ)");
   co.signals = impl_->bridge->signals();
-  co.extra_feeds = {kSlaveSignals};
+  co.extra_feeds = {kSlaveSignals, slave_log_signals()};
+  impl_->slave_csv = out_dir / "slave.csv";
   impl_->settings = s;
   impl_->layout = L;
   co.params = impl_->bridge->params();
@@ -145,12 +275,16 @@ void HilConsole::start() {
   impl_->server->start();
   impl_->bridge->start(*impl_->server);
   impl_->tap = std::thread(
-      [im = impl_.get()] { slave_tap(im->settings, im->layout, *im->server, *im->bridge, im->stop); });
+      [im = impl_.get()] { slave_tap(im->settings, im->layout, *im->server, *im->bridge, im->stop, im->slave_origin); });
+  impl_->log_tail = std::thread([im = impl_.get()] {
+    slave_log_tail(im->slave_csv, im->settings.step_s, *im->server, *im->bridge, im->stop, im->slave_origin);
+  });
 }
 
 void HilConsole::stop() {
   impl_->stop.store(true);
   if (impl_->tap.joinable()) impl_->tap.join();
+  if (impl_->log_tail.joinable()) impl_->log_tail.join();
   if (impl_->bridge) impl_->bridge->stop();
   if (impl_->server) impl_->server->stop();
 }

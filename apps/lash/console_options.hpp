@@ -1,6 +1,7 @@
 #pragma once
 // --console [PORT], --console-bind ADDR, --console-read-only: the live console of a run
 // (docs/console.md). Parsing and wiring only; the console is lash::console.
+#include <filesystem>
 #include <memory>
 #include <string>
 
@@ -26,10 +27,11 @@ console::ConsoleOptions console_options(const ConsoleArgs& a, std::string title)
 
 /// The console of `lash hil run`: its server is bound at construction (in the caller's network
 /// namespace, so the browser reaches it from the host), prints the URL; start() joins the bench's
-/// bus through XCP (call it inside the session's namespace, once the master was started).
+/// bus through XCP (call it inside the session's namespace, once the master was started) and
+/// follows out_dir/slave.csv as the slave writes it (the slave_log_* signals).
 class HilConsole {
  public:
-  HilConsole(const ConsoleArgs& a, const hil::BenchSettings& s);
+  HilConsole(const ConsoleArgs& a, const hil::BenchSettings& s, const std::filesystem::path& out_dir);
   ~HilConsole();
   void start();
   void stop();

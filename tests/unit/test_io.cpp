@@ -10,6 +10,7 @@
 #include "lash/io/atomic_file.hpp"
 #include "lash/io/csv.hpp"
 #include "lash/io/error.hpp"
+#include "lash/io/line_tail.hpp"
 #include "lash/io/numeric.hpp"
 #include "lash/io/table.hpp"
 #include "lash/plant/plant_file.hpp"
@@ -368,4 +369,55 @@ TEST(Numeric, ConversionsAreRangeCheckedFirst) {
   } catch (const std::invalid_argument& e) {
     EXPECT_EQ(std::string(e.what()).rfind("settle_s: ", 0), 0u) << e.what();
   }
+}
+
+namespace {
+std::vector<std::string> poll_all(LineTail& t) {
+  std::vector<std::string> out;
+  t.poll([&](std::string_view l) { out.emplace_back(l); });
+  return out;
+}
+void append(const fs::path& p, const std::string& s) { std::ofstream(p, std::ios::app) << s; }
+}  // namespace
+
+TEST(LineTail, AppendedInPiecesHandsOverCompleteLinesOnly) {
+  const fs::path p = fs::temp_directory_path() / ("lash_test_io_" + std::to_string(::getpid()) + "_tail.csv");
+  fs::remove(p);
+  LineTail t(p);
+  EXPECT_TRUE(poll_all(t).empty());  // no file yet: nothing, no error
+  EXPECT_FALSE(t.opened());
+  append(p, "step,x\n0,1.");
+  EXPECT_EQ(poll_all(t), (std::vector<std::string>{"step,x"}));
+  EXPECT_EQ(t.pending_bytes(), 4u);  // "0,1." waits for its '\n'
+  EXPECT_TRUE(poll_all(t).empty());
+  append(p, "5");
+  EXPECT_TRUE(poll_all(t).empty());
+  append(p, "\r\n1,2\n2,");
+  EXPECT_EQ(poll_all(t), (std::vector<std::string>{"0,1.5", "1,2"}));
+  append(p, "3\n");
+  EXPECT_EQ(poll_all(t), (std::vector<std::string>{"2,3"}));
+  EXPECT_EQ(t.offset(), fs::file_size(p));
+  // Replaced by a shorter file (a new run): read from its start again.
+  std::ofstream(p, std::ios::trunc) << "a\n";
+  EXPECT_EQ(poll_all(t), (std::vector<std::string>{"a"}));
+  EXPECT_EQ(t.restarts(), 1u);
+  fs::remove(p);
+}
+
+TEST(LineTail, BoundedBufferSkipsOverlongLines) {
+  const fs::path p = fs::temp_directory_path() / ("lash_test_io_" + std::to_string(::getpid()) + "_tail2.csv");
+  fs::remove(p);
+  LineTail t(p, 8);
+  append(p, "12345678\n");  // exactly max_line: kept
+  EXPECT_EQ(poll_all(t), (std::vector<std::string>{"12345678"}));
+  append(p, "123456");
+  EXPECT_TRUE(poll_all(t).empty());
+  append(p, std::string(5000, 'x'));  // grows past 8 bytes in pieces: never held
+  EXPECT_TRUE(poll_all(t).empty());
+  EXPECT_LE(t.pending_bytes(), 8u);
+  append(p, std::string(100000, 'y') + "\nok\n");  // read in 64 KiB chunks: the tail of it skipped too
+  EXPECT_EQ(poll_all(t), (std::vector<std::string>{"ok"}));
+  EXPECT_EQ(t.overlong(), 1u);
+  EXPECT_EQ(t.pending_bytes(), 0u);
+  fs::remove(p);
 }

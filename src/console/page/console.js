@@ -17,7 +17,7 @@
   const token = new URLSearchParams(location.search).get("token") || "";
   const H = { "X-Lash-Token": token };
   const COLORS = ["#1565c0", "#c62828", "#2e7d32", "#ef6c00", "#6a1b9a", "#00838f", "#ad1457", "#4e342e"];
-  const EVCOL = { calibration: "#6a1b9a", state: "#c62828", overrun: "#ef6c00", drift: "#00838f",
+  const EVCOL = { calibration: "#6a1b9a", state: "#c62828", slave_state: "#ad1457", overrun: "#ef6c00", drift: "#00838f",
     threshold: "#b71c1c", stale: "#757575", resumed: "#9e9e9e", demo: "#558b2f" };
   const VERDICT = { yes: "#2e7d32", no: "#9e9e9e" };  // identified / not identified
   const $ = (id) => document.getElementById(id);
@@ -31,7 +31,7 @@
 
   function defaultPanels(sigs) {
     const groups = [["slave", /^slave_(measured_kPa|current_mA)$/], ["pressure", /kPa$/], ["current", /mA$/], ["timing", /_us$/],
-      ["state", /^(state|sensor_fresh|dropped)$/], ["frames", /^(overruns|frames_late|frames_lost)$/],
+      ["state", /^(slave_log_)?(state|sensor_fresh|command_fresh|dropped)$/], ["frames", /^(overruns|frames_late|frames_lost)$/],
       ["v", /^v$/], ["y", /^y$/]];
     const used = new Set(), out = [];
     for (const [name, re] of groups) {
