@@ -59,6 +59,12 @@ AlarmSettings read_alarm_settings(TomlTable& t) {
     s.drift.delta = d->number_or("delta", s.drift.delta);
     s.drift.threshold = d->number_or("threshold", s.drift.threshold);
     s.drift.warmup_s = d->number_or("warmup_s", s.drift.warmup_s);
+    if (d->has("median")) {
+      const double m = d->number("median");
+      if (!(m >= 1 && m <= static_cast<double>(DriftSettings::kMaxMedian)) || m != std::floor(m))
+        d->fail("median", "must be an integer from 1 to " + std::to_string(DriftSettings::kMaxMedian));
+      s.drift.median = static_cast<std::size_t>(m);
+    }
     if (auto ps = d->strings_opt("parameters")) {
       s.drift.parameters.clear();
       for (const auto& p : *ps) {
@@ -134,9 +140,10 @@ void EventDetector::update(double t, const std::vector<ParamValue>& params, std:
         tr.started = true;
         tr.scale = std::max(std::abs(p.value), 1e-12);
       }
-      tr.recent[tr.n_recent++ % tr.recent.size()] = p.value;
-      std::array<double, 5> m = tr.recent;
-      const std::size_t k = std::min(tr.n_recent, m.size());
+      const std::size_t len = s_.drift.median;
+      tr.recent[tr.n_recent++ % len] = p.value;
+      std::array<double, DriftSettings::kMaxMedian> m = tr.recent;
+      const std::size_t k = std::min(tr.n_recent, len);
       std::nth_element(m.begin(), m.begin() + static_cast<std::ptrdiff_t>(k / 2), m.begin() + static_cast<std::ptrdiff_t>(k));
       const auto c = tr.ph.update(m[k / 2] / tr.scale);
       if (c != PageHinkley::Change::none) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <tuple>
 
@@ -137,6 +138,18 @@ void OnlineEstimator::feed(double v, double y, bool restart) {
   }
   e.step(v, y);
   fit_.add(y, e.simulated());
+  {
+    const double lam = e.config().rls.lambda;
+    const double err = y - e.simulated();
+    ew_max_ = std::max(ew_max_, std::fabs(y));
+    if (std::isfinite(err)) {
+      ew_sq_ = lam * ew_sq_ + err * err;
+      ew_w_ = lam * ew_w_ + 1.0;
+      if (ew_bad_ > 0) --ew_bad_;
+    } else {  // as bad as can be until the estimator's memory has passed
+      ew_bad_ = lam < 1.0 ? static_cast<std::uint64_t>(std::ceil(1.0 / (1.0 - lam))) : ~std::uint64_t{0};
+    }
+  }
   if (rg_) {
     AnyAdaptor a{e};
     const PerSide<bool> moved = rg_->follow(a, v1);
@@ -154,6 +167,12 @@ void OnlineEstimator::feed(double v, double y, bool restart) {
   ++fed_;
 }
 
+double OnlineEstimator::forgetting_nrmse() const noexcept {
+  if (ew_bad_ > 0) return std::numeric_limits<double>::infinity();
+  if (ew_w_ == 0.0 || ew_max_ == 0.0) return std::numeric_limits<double>::quiet_NaN();
+  return std::sqrt(ew_sq_ / ew_w_) / ew_max_;
+}
+
 std::optional<OnlineSnapshot> OnlineEstimator::snapshot(double t_from, double t_to) {
   if (!est_) return std::nullopt;
   const AnyEstimator& e = *est_;
@@ -162,6 +181,18 @@ std::optional<OnlineSnapshot> OnlineEstimator::snapshot(double t_from, double t_
   ar.cfg = e.config();
   ar.run.report = e.report();
   EstimateReport& rep = ar.run.report;
+  {  // check 6 on the forgetting fit (online.hpp); checks 1-5 passed when the reason is none or poor_fit
+    const double nr = forgetting_nrmse();
+    for (SideReport* sr : {&rep.right, &rep.left}) {
+      Reason& why = sr->params.reason;
+      if (why != Reason::none && why != Reason::poor_fit) continue;
+      why = nr > ar.cfg.fit_threshold ? Reason::poor_fit : Reason::none;  // NaN: no evidence against
+      sr->params.identified = why == Reason::none;
+    }
+    const bool two = model_traits(ar.cfg.model).two_sided;
+    rep.identified = rep.right.params.identified && (!two || rep.left.params.identified) &&
+                     (!rep.has_shared_d || rep.d_reason == Reason::none);
+  }
   if (sections_.size() >= s_.min_sections) {
     const std::vector<PerSide<SideParams>> secs(sections_.begin(), sections_.end());
     const auto ci = section_intervals(ar.cfg, secs, sec_len_, static_cast<std::size_t>(fed_),

@@ -160,6 +160,30 @@ TEST(MonitorEvents, ThresholdOnce) {
   EXPECT_DOUBLE_EQ(ev[1].t, 5);
 }
 
+// A step of c_r from 100 to 132 after 10 periods, δ = 0.03, h = 0.3, warm-up 0 (x = c/100, by hand):
+//   periods 1-10: x = 1, x̄ = 1, U = −0.03·k, m = U = −0.3 after period 10.
+//   median 1: period 11: x̄ = 11.32/11 = 1.02909, U − m = 1.32 − 1.02909 − 0.03 = 0.26091 (< h);
+//             period 12: x̄ = 12.64/12 = 1.05333, U − m = 0.26091 + 0.23667 = 0.49758 > h: alarm at 12.
+//   median 3: period 11 sees median(100, 100, 132) = 100 (U − m = 0 at m = −0.33), then 132 from
+//             period 12: the same two steps one period later: alarm at 13. median 5: at 14.
+TEST(MonitorEvents, DriftMedianDelaysByHand) {
+  for (const auto& [median, alarm_t] : {std::pair{std::size_t{1}, 12.0}, {std::size_t{3}, 13.0}, {std::size_t{5}, 14.0}}) {
+    monitor::AlarmSettings s;
+    s.drift.warmup_s = 0.0;
+    s.drift.median = median;
+    s.drift.parameters = {"c_r"};
+    monitor::EventDetector d(s);
+    std::vector<monitor::Event> ev;
+    for (int k = 1; k <= 16 && ev.empty(); ++k)
+      d.update(k, {monitor::ParamValue{"c_r", k <= 10 ? 100.0 : 132.0, NAN, NAN, true}}, ev);
+    ASSERT_EQ(ev.size(), 1u) << median;
+    EXPECT_EQ(ev[0].kind, "drift");
+    EXPECT_DOUBLE_EQ(ev[0].t, alarm_t) << median;
+    EXPECT_DOUBLE_EQ(ev[0].before, 100.0) << median;
+    EXPECT_DOUBLE_EQ(ev[0].after, 132.0) << median;
+  }
+}
+
 // The persistent estimator is the estimator `lash estimate` runs, stepped once per sample: with the
 // guesses given, no gate and no re-guessing, its state after a record equals an AnyEstimator with the
 // settings resolved from the first init_s seconds stepped over the same samples (all but the last,

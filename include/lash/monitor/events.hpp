@@ -6,10 +6,10 @@
 ///    Edge-triggered: one event on leaving, re-armed on coming back inside.
 ///  - `drift`: the Page–Hinkley test (lash/metrics/page_hinkley.hpp) on the period-by-period
 ///    values of every identified parameter, relative to its value when the warm-up ended
-///    (x / |x_ref|, so δ and h are fractions), fed the running median of the last 5 identified
-///    values (a one- or two-period excursion of an estimate, e.g. when the switching-guess
-///    search moves, is not a change): settings in `[drift]` (`delta`, `threshold`,
-///    `warmup_s`, `enabled`, `parameters`). `before` is the mean up to the estimated change, `after` the
+///    (x / |x_ref|, so δ and h are fractions), fed each period's value as it is (`median = 1`,
+///    the default) or the running median of the last `median` identified values (1..5; a longer
+///    median ignores shorter excursions but delays the alarm by (median − 1)/2 periods):
+///    settings in `[drift]` (`delta`, `threshold`, `warmup_s`, `median`, `enabled`, `parameters`). `before` is the mean up to the estimated change, `after` the
 ///    value at the alarm; the test restarts after each alarm.
 /// Not real-time code (runs once per period).
 #include <array>
@@ -34,6 +34,10 @@ struct DriftSettings {
   double delta = 0.03;      ///< δ of the Page–Hinkley test [fraction of the reference value]
   double threshold = 0.3;   ///< h [fraction of the reference value]
   double warmup_s = 8.0;    ///< no drift test before this long after the first estimate [s]
+  /// the test is fed the running median of the last this many identified period values (1 = the
+  /// values themselves; at most kMaxMedian)
+  std::size_t median = 1;
+  static constexpr std::size_t kMaxMedian = 5;
   /// Parameters the test watches (`parameters = [...]`). Default: the nonlinearity and the gain
   /// (c, d, K per side; K, d); τ's estimate moves by tens of percent between periods on closed-loop
   /// data and is watched only when named.
@@ -83,7 +87,7 @@ class EventDetector {
     PageHinkley ph;
     bool outside = false;
     double last = std::numeric_limits<double>::quiet_NaN();
-    std::array<double, 5> recent{};  ///< the last identified values (ring), for the running median
+    std::array<double, DriftSettings::kMaxMedian> recent{};  ///< the last identified values (ring), for the running median
     std::size_t n_recent = 0;
   };
   AlarmSettings s_;

@@ -20,6 +20,10 @@
 ///  - 95 % intervals by batch means (intervals.hpp) over the last `sections` sections of
 ///    `section_s` seconds, each estimated alone by a second estimator run alongside.
 ///  - NRMSE: of the estimator's free run over the samples of the period (the snapshot's window).
+///  - The verdict's fit check (check 6, `poor_fit`) uses a **forgetting** NRMSE of that free run,
+///    exponentially weighted with the estimator's own memory λ (sqrt(Σλ^j e²/Σλ^j) / max|y|), in
+///    place of the estimator's fit since its start, which never forgets: a side whose fit was poor
+///    for a while (a re-guess, a drift) is judged on its recent fit. Checks 1–5 are the estimator's.
 /// add() is O(1) amortised (no allocation after the first stretch); snapshot() is O(sections).
 /// Not real-time code (snapshot allocates the JSON).
 #include <cstdint>
@@ -96,6 +100,11 @@ class OnlineEstimator {
   double v_prev_ = 0.0;
   std::uint64_t fed_ = 0, gaps_n_ = 0, restarts_ = 0, outliers_ = 0;
   NrmseAccumulator fit_;
+  /// the forgetting fit (verdict check 6): Σλ^j e², Σλ^j, max|y|; samples until a non-finite
+  /// free-run error is forgotten
+  double ew_sq_ = 0.0, ew_w_ = 0.0, ew_max_ = 0.0;
+  std::uint64_t ew_bad_ = 0;
+  double forgetting_nrmse() const noexcept;
   std::size_t sec_len_ = 0, sec_n_ = 0;
   std::deque<PerSide<SideParams>> sections_;  ///< the last s_.sections finished sections
 };
