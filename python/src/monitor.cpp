@@ -116,7 +116,7 @@ void bind_monitor(pyb::module_& m) {
   m.def("monitor_log", &monitor_log, pyb::arg("path"), pyb::arg("dbc"), pyb::arg("v"), pyb::arg("y"), pyb::kw_only(),
         pyb::arg("model") = "deadzone-deadband", pyb::arg("preset") = "lash", pyb::arg("every") = 1.0,
         pyb::arg("dt") = 0.0, pyb::arg("window") = 120.0, pyb::arg("stale_timeout") = 0.5,
-        pyb::arg("record") = "", pyb::arg("db") = "", pyb::arg("jsonl") = "", pyb::arg("estimate") = "online",
+        pyb::arg("record") = "", pyb::arg("db") = "", pyb::arg("jsonl") = "", pyb::arg("estimate") = "window",
         pyb::arg("init") = 10.0,
         "monitor_log(path, dbc, v, y, *, model='deadzone-deadband', preset='lash', every=1.0, dt=0.0,\n"
         "            window=120.0, stale_timeout=0.5, record='', db='', jsonl='', estimate='online', init=10.0,\n"

@@ -133,13 +133,13 @@ def test_bad_input_names_it(files):
 
 
 def test_online_drift_and_reguesses(files):
-    """The default persistent estimator on the drift log: the drift event after the change, the
+    """The persistent estimator (estimate="online") on the drift log: the drift event after the change, the
     right edge of the last period at the new value, the re-guess counts in the counts dict."""
     tmp, dbc = files
     log = tmp / "drift.log"
     write_log(log, 40.0, c_r_after=400.0, t_change=20.0, seed=5)
     h = lash.monitor_log(str(log), dbc, "Cmd.CurrentA-Cmd.CurrentB", "Sens.Pressure", model="input-deadzone",
-                         rls={"lambda": 0.995})
+                         rls={"lambda": 0.995}, estimate="online")
     ev = h["events"]
     assert all(t >= 20.0 for t in ev["t"]), ev
     drift = [t for t, k, p in zip(ev["t"], ev["kind"], ev["param"]) if k == "drift" and p == "c_r"]

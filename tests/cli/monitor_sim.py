@@ -132,9 +132,9 @@ assert same >= 20, same
 print(f"damaged log: {garbage} garbage lines, 1 silence, 1 counter jump counted; {same} periods outside the damage "
       f"equal the clean log's")
 
-# the persistent estimator (default): identical until the damage, close to the clean log after it
-co_est, _, _ = monitor(clean_log, "--quiet")
-do_est, _, err = monitor(bad_log)
+# the persistent estimator (--estimate online): identical until the damage, close to the clean log after it
+co_est, _, _ = monitor(clean_log, "--estimate", "online", "--quiet")
+do_est, _, err = monitor(bad_log, "--estimate", "online")
 summary = dict(re.findall(r"(garbage|counter_jumps|stale) (\d+)", err))
 assert summary == {"garbage": str(garbage), "counter_jumps": "1", "stale": "1"}, err
 co_by_t = {round(e["t"], 6): e for e in co_est[:-1]}
@@ -154,7 +154,7 @@ print(f"damaged log, persistent estimator: {before} periods before the silence e
 
 # --- online re-guessing: guesses given far inside the deadzone -----------------------------------
 drift_log = os.path.join(tmp, "drift.log")
-est, _, err = monitor(drift_log, "--guess-right", "150", "--guess-left", "-150")
+est, _, err = monitor(drift_log, "--estimate", "online", "--guess-right", "150", "--guess-left", "-150")
 periods = est[:-1]
 n_r, n_l = periods[-1]["reguesses"]["right"], periods[-1]["reguesses"]["left"]
 assert n_r >= 1 and n_l >= 1, periods[-1]["reguesses"]
@@ -163,7 +163,8 @@ last = periods[-1]
 assert last["right"]["identified"] and abs(last["right"]["c"] - 380) < 0.05 * 380, last["right"]
 assert last["left"]["identified"] and abs(last["left"]["c"] + 296) < 0.05 * 296, last["left"]
 assert last["right"]["guess"]["value"] > 380 and last["left"]["guess"]["value"] < -296, (last["right"], last["left"])
-frozen, _, _ = monitor(drift_log, "--guess-right", "150", "--guess-left", "-150", "--no-reguess", "--quiet")
+frozen, _, _ = monitor(drift_log, "--estimate", "online", "--guess-right", "150", "--guess-left", "-150", "--no-reguess",
+                       "--quiet")
 assert frozen[-2]["right"]["reason"] == "wrong_guess" and frozen[-2]["reguesses"] == {"right": 0, "left": 0}, \
     frozen[-2]["right"]
 print(f"re-guessing from +-150 mA: {n_r} right / {n_l} left moves; last period c_r = {last['right']['c']:.1f} mA "

@@ -10,9 +10,9 @@
 /// Sampling: each frame of y's message is one sample (t = the frame's time, v = the latest v
 /// received before it), or with dt_s > 0 a zero-order hold at t0 + k·dt (v and y the latest
 /// values received at or before that instant). t is in seconds since the first sample.
-/// Each period's estimate (mode online, the default) is a snapshot of one persistent estimator
-/// fed every sample (online.hpp: settings and guesses from the first stretch, re-guessing,
-/// O(1) per period); mode window: estimate_arrays over the samples of the last window_s seconds.
+/// Each period's estimate (mode window, the default) is estimate_arrays over the samples of the
+/// last window_s seconds; mode online: a snapshot of one persistent estimator fed every sample
+/// (online.hpp: settings and guesses from the first stretch, re-guessing, O(1) per period).
 /// The final estimate, in both modes, is estimate_arrays over the last window_s seconds (default
 /// 120 s; 0 = every sample so far), restarted at the record's timestamp gaps (as `lash estimate`)
 /// and where a silence or an alive-counter jump was seen: it equals
@@ -54,7 +54,7 @@ struct MonitorSettings {
   /// (T = the period's end), and the monitor keeps at most 2·window_s seconds of samples (bounded
   /// memory and cost per period); 0: every sample since the start (memory and cost grow with the run) [s]
   double window_s = 120.0;
-  EstimateMode mode = EstimateMode::online;  ///< per-period estimate (the final one is always the window's)
+  EstimateMode mode = EstimateMode::window;  ///< per-period estimate (the final one is always the window's)
   OnlineSettings online;           ///< the persistent estimator's settings (mode online)
   double duration_s = 0.0;         ///< > 0: stop after this long (frame time; live: also wall time) [s]
   bool realtime = false;           ///< a log at its recorded pace
