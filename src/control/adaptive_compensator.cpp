@@ -214,6 +214,7 @@ const char* verdict_text(Reason r) noexcept {
     case Reason::unphysical: return "unphysical: b1 <= 0 or the edge on the wrong side of zero";
     case Reason::poor_fit: return "poor_fit: the free run does not fit";
     case Reason::wrong_guess: return "wrong_guess: the edge lies outside this side's guess";
+    case Reason::uncertain: return "uncertain: a 95 % interval reaches a physically impossible value";
   }
   return "?";
 }

@@ -135,9 +135,20 @@ void add_intervals(EstimationRun& run, const EstimatorConfig& cfg, std::span<con
                    std::span<const double> y, std::span<const std::size_t> gap_rows) {
   IntervalSettings s;
   s.gap_rows = gap_rows;
-  const auto ci = batch_means_intervals(cfg, v, y, {run.report.right.params, run.report.left.params}, s);
-  if (run.report.right.params.identified) run.report.right.ci95 = ci.right;
-  if (run.report.left.params.identified) run.report.left.ci95 = ci.left;
+  attach_intervals(run.report, batch_means_intervals(cfg, v, y, {run.report.right.params, run.report.left.params}, s));
+}
+
+void attach_intervals(EstimateReport& rep, const PerSide<SideIntervals>& ci) {
+  const bool two = model_traits(rep.model).two_sided;
+  for (const Side s : {Side::right, Side::left}) {
+    SideReport& r = s == Side::right ? rep.right : rep.left;
+    if (!r.params.identified) continue;
+    r.ci95 = ci[s];
+    if (interval_verdict(ci[s], s) == Reason::none) continue;
+    r.params.reason = Reason::uncertain;
+    r.params.identified = false;
+    if (s == Side::right || two) rep.identified = false;
+  }
 }
 
 }  // namespace lash

@@ -12,6 +12,17 @@
 
 namespace lash {
 
+Reason interval_verdict(const SideIntervals& ci, Side s) noexcept {
+  auto reaches = [](const Interval& i, auto bad) { return i.valid() && (bad(i.lo) || bad(i.hi)); };
+  const bool impossible =
+      reaches(ci.a1, [](double a) { return !(a < 0.0); }) ||
+      reaches(ci.K, [](double k) { return !(k > 0.0); }) ||
+      reaches(ci.tau_s, [](double t) { return !(t > 0.0); }) ||
+      reaches(ci.c, [s](double c) { return !verdict_rules::physical_edge(c, s); }) ||
+      reaches(ci.d, [](double d) { return !(d >= 0.0); });
+  return impossible ? Reason::uncertain : Reason::none;
+}
+
 double student_t975(std::size_t dof) noexcept {
   // t_{0.975, n}, n = 1 … 30 (any statistics table; scipy.stats.t.ppf(0.975, n))
   static constexpr std::array<double, 30> t{12.7062047, 4.30265273, 3.18244631, 2.77644511, 2.57058184, 2.44691185,

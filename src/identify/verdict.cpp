@@ -15,6 +15,7 @@ const char* to_string(Reason r) noexcept {
     case Reason::unphysical: return "unphysical";
     case Reason::poor_fit: return "poor_fit";
     case Reason::wrong_guess: return "wrong_guess";
+    case Reason::uncertain: return "uncertain";
   }
   return "?";
 }

@@ -85,11 +85,12 @@ AlarmSettings read_alarm_settings(TomlTable& t) {
 
 std::vector<ParamValue> monitored_params(const EstimateReport& r) {
   std::vector<ParamValue> out;
-  const auto put = [&](const std::string& name, double v, const Interval& iv, bool identified) {
+  const auto put = [&](const std::string& name, double v, const Interval& iv, const SideParams& sp) {
     ParamValue p;
     p.name = name;
     p.value = v;
-    p.identified = identified && std::isfinite(v);
+    p.identified = sp.identified && std::isfinite(v);
+    p.watched = (sp.identified || sp.reason == Reason::uncertain) && std::isfinite(v);
     if (iv.valid()) {
       p.lo = iv.lo;
       p.hi = iv.hi;
@@ -97,18 +98,22 @@ std::vector<ParamValue> monitored_params(const EstimateReport& r) {
     out.push_back(p);
   };
   if (r.model == ModelKind::linear) {
-    put("K", r.right.K, r.right.ci95.K, r.right.params.identified);
-    put("tau_s", r.right.tau_s, r.right.ci95.tau_s, r.right.params.identified);
+    put("K", r.right.K, r.right.ci95.K, r.right.params);
+    put("tau_s", r.right.tau_s, r.right.ci95.tau_s, r.right.params);
     return out;
   }
   for (const auto& [sfx, s] : {std::pair{"_r", &r.right}, std::pair{"_l", &r.left}}) {
-    const bool id = s->params.identified;
-    if (r.has_c) put(std::string("c") + sfx, s->params.c, s->ci95.c, id);
-    if (r.has_side_d) put(std::string("d") + sfx, s->params.d, s->ci95.d, id);
-    put(std::string("K") + sfx, s->K, s->ci95.K, id);
-    put(std::string("tau_s") + sfx, s->tau_s, s->ci95.tau_s, id);
+    if (r.has_c) put(std::string("c") + sfx, s->params.c, s->ci95.c, s->params);
+    if (r.has_side_d) put(std::string("d") + sfx, s->params.d, s->ci95.d, s->params);
+    put(std::string("K") + sfx, s->K, s->ci95.K, s->params);
+    put(std::string("tau_s") + sfx, s->tau_s, s->ci95.tau_s, s->params);
   }
-  if (r.has_shared_d) put("d", r.d, r.right.ci95.d, r.d_reason == Reason::none);
+  if (r.has_shared_d) {
+    SideParams dp;
+    dp.reason = r.d_reason;
+    dp.identified = r.d_reason == Reason::none;
+    put("d", r.d, r.right.ci95.d, dp);
+  }
   return out;
 }
 
@@ -120,7 +125,7 @@ void EventDetector::update(double t, const std::vector<ParamValue>& params, std:
     t0_ = t;
   }
   for (const ParamValue& p : params) {
-    if (!p.identified) continue;
+    if (!p.watched) continue;
     auto it = tracks_.find(p.name);
     if (it == tracks_.end())
       it = tracks_.emplace(p.name, Track{false, 1.0, PageHinkley({s_.drift.delta, s_.drift.threshold}), false,

@@ -197,8 +197,7 @@ std::optional<OnlineSnapshot> OnlineEstimator::snapshot(double t_from, double t_
     const std::vector<PerSide<SideParams>> secs(sections_.begin(), sections_.end());
     const auto ci = section_intervals(ar.cfg, secs, sec_len_, static_cast<std::size_t>(fed_),
                                       {rep.right.params, rep.left.params}, s_.min_sections);
-    if (rep.right.params.identified) rep.right.ci95 = ci.right;
-    if (rep.left.params.identified) rep.left.ci95 = ci.left;
+    attach_intervals(rep, ci);
   }
   if (uses_guesses_) {
     for (const auto& [side, g, source] : {std::tuple{Side::right, &ar.right, src_r_}, std::tuple{Side::left, &ar.left, src_l_}}) {

@@ -67,3 +67,67 @@ TEST(Intervals, E2CoverageOverTwentySeeds) {
 
 }  // namespace
 }  // namespace lash
+
+// Verdict check 7 (intervals.hpp): the hand-made intervals below reach an impossible value
+// exactly where the comment says.
+TEST(Intervals, VerdictUncertainWhereAnIntervalReachesTheImpossible) {
+  using lash::Interval;
+  using lash::Reason;
+  using lash::Side;
+  lash::SideIntervals ok;
+  ok.a1 = {-1.2, -0.5};  // reaches below -1: an integrator's limit, not tested
+  ok.b1 = {-0.1, 0.3};   // b1 alone spans zero: not tested (K is the physical quantity)
+  ok.c = {150.0, 250.0};
+  ok.d = {0.0, 40.0};
+  ok.K = {0.5, 3.0};
+  ok.tau_s = {0.01, 0.2};
+  EXPECT_EQ(lash::interval_verdict(ok, Side::right), Reason::none);
+  EXPECT_EQ(lash::interval_verdict(lash::SideIntervals{}, Side::right), Reason::none);  // no intervals
+  auto with = [&](auto edit) {
+    lash::SideIntervals c = ok;
+    edit(c);
+    return lash::interval_verdict(c, Side::right);
+  };
+  EXPECT_EQ(with([](auto& c) { c.a1 = {-0.5, 0.0}; }), Reason::uncertain);     // a1 = 0: no lag
+  EXPECT_EQ(with([](auto& c) { c.K = {-0.26, 1.06}; }), Reason::uncertain);    // K <= 0
+  EXPECT_EQ(with([](auto& c) { c.tau_s = {-0.001, 0.1}; }), Reason::uncertain);  // tau <= 0
+  EXPECT_EQ(with([](auto& c) { c.d = {-0.5, 3.0}; }), Reason::uncertain);      // d < 0
+  EXPECT_EQ(with([](auto& c) { c.c = {-5.0, 10.0}; }), Reason::uncertain);     // c_r < 0
+  lash::SideIntervals left = ok;
+  left.c = {-250.0, -150.0};
+  EXPECT_EQ(lash::interval_verdict(left, Side::left), Reason::none);
+  left.c = {-10.0, 5.0};  // c_l > 0
+  EXPECT_EQ(lash::interval_verdict(left, Side::left), Reason::uncertain);
+}
+
+// attach_intervals: an uncertain side keeps its values and intervals, is not identified, and
+// neither is the model; a side not identified gets no intervals.
+TEST(Intervals, AttachMarksTheUncertainSide) {
+  lash::EstimateReport rep;
+  rep.model = lash::ModelKind::input_deadzone;
+  rep.identified = true;
+  for (lash::SideReport* s : {&rep.right, &rep.left}) {
+    s->params.identified = true;
+    s->params.reason = lash::Reason::none;
+    s->params.c = s == &rep.right ? 203.0 : -174.0;
+  }
+  lash::PerSide<lash::SideIntervals> ci{};
+  ci.right.K = {1.36, 2.97};
+  ci.left.K = {-0.26, 1.06};
+  lash::attach_intervals(rep, ci);
+  EXPECT_TRUE(rep.right.params.identified);
+  EXPECT_EQ(rep.right.ci95.K.lo, 1.36);
+  EXPECT_FALSE(rep.left.params.identified);
+  EXPECT_EQ(rep.left.params.reason, lash::Reason::uncertain);
+  EXPECT_EQ(rep.left.params.c, -174.0);
+  EXPECT_EQ(rep.left.ci95.K.lo, -0.26);
+  EXPECT_FALSE(rep.identified);
+  lash::EstimateReport lin;  // linear: only the right side counts
+  lin.model = lash::ModelKind::linear;
+  lin.identified = true;
+  lin.right.params.identified = true;
+  lin.right.params.reason = lash::Reason::none;
+  lash::attach_intervals(lin, ci);  // right: K positive; left not identified: untouched
+  EXPECT_TRUE(lin.identified);
+  EXPECT_FALSE(lin.left.ci95.K.valid());
+}

@@ -145,7 +145,7 @@ TEST(MonitorEvents, ThresholdOnce) {
   monitor::EventDetector d(s);
   std::vector<monitor::Event> ev;
   const auto period = [&](double t, double x) {
-    d.update(t, {monitor::ParamValue{"d_r", x, NAN, NAN, true}}, ev);
+    d.update(t, {monitor::ParamValue{"d_r", x, NAN, NAN, true, true}}, ev);
   };
   period(1, 30);
   period(2, 45);
@@ -175,7 +175,7 @@ TEST(MonitorEvents, DriftMedianDelaysByHand) {
     monitor::EventDetector d(s);
     std::vector<monitor::Event> ev;
     for (int k = 1; k <= 16 && ev.empty(); ++k)
-      d.update(k, {monitor::ParamValue{"c_r", k <= 10 ? 100.0 : 132.0, NAN, NAN, true}}, ev);
+      d.update(k, {monitor::ParamValue{"c_r", k <= 10 ? 100.0 : 132.0, NAN, NAN, true, true}}, ev);
     ASSERT_EQ(ev.size(), 1u) << median;
     EXPECT_EQ(ev[0].kind, "drift");
     EXPECT_DOUBLE_EQ(ev[0].t, alarm_t) << median;

@@ -215,5 +215,9 @@ EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> 
 /// intervals.hpp: runs the estimator once more over sections of the same record).
 void add_intervals(EstimationRun& run, const EstimatorConfig& cfg, std::span<const double> v,
                    std::span<const double> y, std::span<const std::size_t> gap_rows = {});
+/// Sets the 95 % intervals ci on the identified sides of rep and applies verdict check 7
+/// (interval_verdict): a side whose interval reaches a physically impossible value becomes
+/// `uncertain` (not identified; its intervals kept, to show why), and so does the model.
+void attach_intervals(EstimateReport& rep, const PerSide<SideIntervals>& ci);
 
 }  // namespace lash

@@ -55,6 +55,16 @@ PerSide<SideIntervals> section_intervals(const EstimatorConfig& cfg, std::span<c
                                          std::size_t section_len, std::size_t n,
                                          const PerSide<SideParams>& estimate, std::size_t min_sections = 5);
 
+/// Check 7 of verdict.hpp on one side's intervals: Reason::uncertain when one of them reaches a
+/// physically impossible value — a1 ≥ 0 or τ ≤ 0 (a first-order lag has a pole −a1 in (0, 1) and
+/// τ = −T/ln(−a1) > 0), K ≤ 0 (the static gain b1/(1 + a1) is positive), an edge on the wrong
+/// side of zero (c_r < 0 or c_l > 0), d < 0 — else Reason::none. An interval not computed
+/// (invalid) passes. Not tested: a1 ≤ −1 (a pole at 1 is an integrator, τ → ∞, a limit a slow
+/// lag's symmetric interval reaches without the estimate being wrong) and b1 ≤ 0 on its own
+/// (where the input excites slowly a1 and b1 are strongly correlated: the valve's b1 interval
+/// spans zero while its K interval is 1.25–3.04; the physical quantity is K).
+Reason interval_verdict(const SideIntervals& ci, Side s) noexcept;
+
 /// Student's t quantile t_{0.975, dof} for dof ≥ 1 (table to 30, then the normal-limit series).
 double student_t975(std::size_t dof) noexcept;
 

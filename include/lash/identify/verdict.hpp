@@ -19,7 +19,10 @@
 ///  5. the switching guesses were right: an input-side model's edge lies inside its guesses,
 ///     c_l* < c < c_r* (eq. 18) — else `wrong_guess` (the side's guess is inside the deadzone);
 ///  6. the model fits: the free-run NRMSE of the whole model over its fit window is at most
-///     `fit_threshold` (checked by `verdict()`) — else `poor_fit`.
+///     `fit_threshold` (checked by `verdict()`) — else `poor_fit`;
+///  7. where 95 % intervals were computed (`lash estimate`, the monitor; intervals.hpp), none of
+///     them reaches a physically impossible value (a1 < 0 and τ > 0; K > 0; the
+///     edge on its own side of zero; d ≥ 0) — else `uncertain` (interval_verdict).
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -31,9 +34,9 @@
 
 namespace lash {
 
-enum class Reason : std::uint8_t { none, not_updated, not_excited, unstable, unphysical, poor_fit, wrong_guess };
+enum class Reason : std::uint8_t { none, not_updated, not_excited, unstable, unphysical, poor_fit, wrong_guess, uncertain };
 
-/// "none", "not_updated", "not_excited", "unstable", "unphysical", "poor_fit", "wrong_guess".
+/// "none", "not_updated", "not_excited", "unstable", "unphysical", "poor_fit", "wrong_guess", "uncertain".
 const char* to_string(Reason r) noexcept;
 
 /// The one text of both sides' verdicts, "right: <right>; left: <left>", written into `out`

@@ -60,6 +60,10 @@ struct ParamValue {
   double lo = std::numeric_limits<double>::quiet_NaN();
   double hi = std::numeric_limits<double>::quiet_NaN();
   bool identified = false;
+  /// The point estimate passed the verdict's checks 1–6 (identified, or `uncertain` by check 7
+  /// only: its interval reaches an impossible value, as a window holding a drift's two levels
+  /// makes it): what the events follow.
+  bool watched = false;
 };
 
 /// The parameters the monitor follows, from a report (sides the model has, names as above).
