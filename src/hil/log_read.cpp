@@ -1,4 +1,4 @@
-// The nodes' CSV logs read back (node_run.hpp: read_master_log / read_slave_log): what a session
+// The nodes' CSV logs read back (handover.hpp: LogReader): what a session
 // reports from, and what it recovers when a node was killed before it could hand its run over.
 #include <cerrno>
 #include <cmath>
@@ -105,31 +105,5 @@ bool LogReader<Row>::next(Row& l, rt::StepRecord& record) {
 
 template class LogReader<MasterStepLog>;
 template class LogReader<SlaveStepLog>;
-
-// ----------------------------------------------------------------------------- whole logs
-
-LogReadBack read_master_log(const std::filesystem::path& path, std::vector<MasterStepLog>& log,
-                            std::vector<rt::StepRecord>& records) {
-  MasterLogReader in(path);
-  MasterStepLog l;
-  rt::StepRecord r;
-  while (in.next(l, r)) {
-    log.push_back(l);
-    records.push_back(r);
-  }
-  return in.read_back();
-}
-
-LogReadBack read_slave_log(const std::filesystem::path& path, std::vector<SlaveStepLog>& log,
-                           std::vector<rt::StepRecord>& records) {
-  SlaveLogReader in(path);
-  SlaveStepLog l;
-  rt::StepRecord r;
-  while (in.next(l, r)) {
-    log.push_back(l);
-    records.push_back(r);
-  }
-  return in.read_back();
-}
 
 }  // namespace lash::hil

@@ -43,12 +43,6 @@ extern template class LogReader<SlaveStepLog>;
 using MasterLogReader = LogReader<MasterStepLog>;
 using SlaveLogReader = LogReader<SlaveStepLog>;
 
-/// The whole log in memory (tests, tools): every row and its record appended to log / records.
-LogReadBack read_master_log(const std::filesystem::path& path, std::vector<MasterStepLog>& log,
-                            std::vector<rt::StepRecord>& records);
-LogReadBack read_slave_log(const std::filesystem::path& path, std::vector<SlaveStepLog>& log,
-                           std::vector<rt::StepRecord>& records);
-
 /// Binary hand-over of a run from a node process to its session (same executable on both
 /// sides): write at the end of the run to an inherited descriptor, read back after it exited.
 /// read_* returns false when the node wrote nothing (it was killed) or the data are cut short.
