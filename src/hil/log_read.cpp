@@ -1,4 +1,4 @@
-// The nodes' CSV logs read back (node_run.hpp: read_master_log / read_slave_log): what a session
+// The nodes' CSV logs read back (handover.hpp: LogReader): what a session
 // reports from, and what it recovers when a node was killed before it could hand its run over.
 #include <cerrno>
 #include <cmath>
@@ -41,22 +41,14 @@ const std::vector<std::string> kSlaveColumns{"step",         "t_s",          "st
                                              "command_fresh", "dropped",     "current_mA",   "pressure_kPa",
                                              "measured_kPa", "pilot_raw",    "tet_us",       "io_us",
                                              "wake_latency_us"};
-}  // namespace
 
-struct MasterLogReader::Impl {
-  explicit Impl(const std::filesystem::path& p) : in(p, master_columns()) {}
-  LogLines in;
-  std::vector<double> v;
-};
+// What differs between the two logs: their columns and how a row's values fill a Row. fill()
+// returns the index of tet_us (io_us and wake_latency_us follow it).
+std::vector<std::string> columns_of(const MasterStepLog*) { return master_columns(); }
+std::vector<std::string> columns_of(const SlaveStepLog*) { return kSlaveColumns; }
 
-MasterLogReader::MasterLogReader(const std::filesystem::path& path) : impl_(std::make_unique<Impl>(path)) {}
-MasterLogReader::~MasterLogReader() = default;
-
-bool MasterLogReader::next(MasterStepLog& l, rt::StepRecord& record) {
-  if (!impl_->in.next(impl_->v, rb_)) return false;
-  const std::vector<double>& v = impl_->v;
+std::size_t fill(MasterStepLog& l, const std::vector<double>& v) {
   static const auto fields = calibration_fields();
-  l = MasterStepLog{};
   l.step = static_cast<std::uint32_t>(v[0]);
   l.state = static_cast<NodeState>(static_cast<int>(v[2]));
   l.control_step = static_cast<std::int64_t>(v[3]);
@@ -71,24 +63,10 @@ bool MasterLogReader::next(MasterStepLog& l, rt::StepRecord& record) {
   l.command_sent = v[12] >= 0.0;
   l.command_counter = l.command_sent ? static_cast<std::uint16_t>(v[12]) : 0;
   for (std::size_t j = 0; j < fields.size(); ++j) l.calibration.*fields[j].member = v[16 + j];
-  record = record_of(v[1], v[13], v[14], v[15]);
-  rb_.last_t_s = v[1];
-  return true;
+  return 13;
 }
 
-struct SlaveLogReader::Impl {
-  explicit Impl(const std::filesystem::path& p) : in(p, kSlaveColumns) {}
-  LogLines in;
-  std::vector<double> v;
-};
-
-SlaveLogReader::SlaveLogReader(const std::filesystem::path& path) : impl_(std::make_unique<Impl>(path)) {}
-SlaveLogReader::~SlaveLogReader() = default;
-
-bool SlaveLogReader::next(SlaveStepLog& l, rt::StepRecord& record) {
-  if (!impl_->in.next(impl_->v, rb_)) return false;
-  const std::vector<double>& v = impl_->v;
-  l = SlaveStepLog{};
+std::size_t fill(SlaveStepLog& l, const std::vector<double>& v) {
   l.step = static_cast<std::uint32_t>(v[0]);
   l.state = static_cast<NodeState>(static_cast<int>(v[2]));
   l.command_counter = static_cast<std::uint64_t>(v[3]);
@@ -98,35 +76,34 @@ bool SlaveLogReader::next(SlaveStepLog& l, rt::StepRecord& record) {
   l.pressure_kPa = v[7];
   l.measured_kPa = v[8];
   l.pilot_raw = static_cast<std::uint16_t>(v[9]);
-  record = record_of(v[1], v[10], v[11], v[12]);
+  return 10;
+}
+}  // namespace
+
+template <class Row>
+struct LogReader<Row>::Impl {
+  explicit Impl(const std::filesystem::path& p) : in(p, columns_of(static_cast<const Row*>(nullptr))) {}
+  LogLines in;
+  std::vector<double> v;
+};
+
+template <class Row>
+LogReader<Row>::LogReader(const std::filesystem::path& path) : impl_(std::make_unique<Impl>(path)) {}
+template <class Row>
+LogReader<Row>::~LogReader() = default;
+
+template <class Row>
+bool LogReader<Row>::next(Row& l, rt::StepRecord& record) {
+  if (!impl_->in.next(impl_->v, rb_)) return false;
+  const std::vector<double>& v = impl_->v;
+  l = Row{};
+  const std::size_t tet = fill(l, v);
+  record = record_of(v[1], v[tet], v[tet + 1], v[tet + 2]);
   rb_.last_t_s = v[1];
   return true;
 }
 
-// ----------------------------------------------------------------------------- whole logs
-
-LogReadBack read_master_log(const std::filesystem::path& path, std::vector<MasterStepLog>& log,
-                            std::vector<rt::StepRecord>& records) {
-  MasterLogReader in(path);
-  MasterStepLog l;
-  rt::StepRecord r;
-  while (in.next(l, r)) {
-    log.push_back(l);
-    records.push_back(r);
-  }
-  return in.read_back();
-}
-
-LogReadBack read_slave_log(const std::filesystem::path& path, std::vector<SlaveStepLog>& log,
-                           std::vector<rt::StepRecord>& records) {
-  SlaveLogReader in(path);
-  SlaveStepLog l;
-  rt::StepRecord r;
-  while (in.next(l, r)) {
-    log.push_back(l);
-    records.push_back(r);
-  }
-  return in.read_back();
-}
+template class LogReader<MasterStepLog>;
+template class LogReader<SlaveStepLog>;
 
 }  // namespace lash::hil

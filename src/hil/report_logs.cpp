@@ -73,7 +73,7 @@ class LoopSummaries {
   std::array<rt::StreamSummary, 4> tails_;
 };
 
-template <class Reader, class Row, class OnRow>
+template <class Row, class OnRow>
 NodeLogScan scan_log(const std::filesystem::path& path, OnRow on_row) {
   NodeLogScan s;
   s.file = path;
@@ -81,7 +81,7 @@ NodeLogScan scan_log(const std::filesystem::path& path, OnRow on_row) {
   Row l;
   rt::StepRecord rec;
   {
-    Reader in(path);
+    LogReader<Row> in(path);
     while (in.next(l, rec)) {
       loop.first(rec);
       s.last_state = l.state;
@@ -91,7 +91,7 @@ NodeLogScan scan_log(const std::filesystem::path& path, OnRow on_row) {
   }
   if (s.read.rows > 0) {
     loop.begin_second();
-    Reader in(path);
+    LogReader<Row> in(path);
     while (in.next(l, rec)) loop.second(rec);
   }
   loop.result(s);
@@ -100,41 +100,39 @@ NodeLogScan scan_log(const std::filesystem::path& path, OnRow on_row) {
 
 // ----------------------------------------------------------------------------- readers
 
-/// The control rows of a master log (control_step ≥ 0), one ahead.
-class ControlRows {
+/// The rows of a node's log that `keep` takes (all without it), one ahead.
+template <class Row>
+class RowsAhead {
  public:
-  explicit ControlRows(const std::filesystem::path& p) : in_(p) { advance(); }
+  explicit RowsAhead(const std::filesystem::path& p, bool (*keep)(const Row&) = nullptr) : in_(p), keep_(keep) {
+    advance();
+  }
   bool done() const noexcept { return done_; }
-  const MasterStepLog& row() const noexcept { return row_; }
+  const Row& row() const noexcept { return row_; }
   void advance() {
     rt::StepRecord r;
     while (in_.next(row_, r))
-      if (row_.control_step >= 0) return;
+      if (!keep_ || keep_(row_)) return;
     done_ = true;
   }
 
  private:
-  MasterLogReader in_;
-  MasterStepLog row_;
+  LogReader<Row> in_;
+  bool (*keep_)(const Row&);
+  Row row_;
   bool done_ = false;
+};
+
+bool is_control_row(const MasterStepLog& l) { return l.control_step >= 0; }
+
+/// The control rows of a master log (control_step ≥ 0), one ahead.
+class ControlRows : public RowsAhead<MasterStepLog> {
+ public:
+  explicit ControlRows(const std::filesystem::path& p) : RowsAhead(p, is_control_row) {}
 };
 
 /// The rows of a slave log, one ahead.
-class SlaveRows {
- public:
-  explicit SlaveRows(const std::filesystem::path& p) : in_(p) { advance(); }
-  bool done() const noexcept { return done_; }
-  const SlaveStepLog& row() const noexcept { return row_; }
-  void advance() {
-    rt::StepRecord r;
-    done_ = !in_.next(row_, r);
-  }
-
- private:
-  SlaveLogReader in_;
-  SlaveStepLog row_;
-  bool done_ = false;
-};
+using SlaveRows = RowsAhead<SlaveStepLog>;
 
 /// compare_with_simulation() of the master log (control rows in ascending control step, as the
 /// nodes write them) with simulated rows given one at a time, also in ascending control step.
@@ -272,7 +270,7 @@ NodeLogScan scan_master_log(const std::filesystem::path& path) {
   std::int64_t last_m = -1;
   std::size_t control_rows = 0;
   std::vector<MasterConfig::CalibrationChange> cal;
-  NodeLogScan s = scan_log<MasterLogReader, MasterStepLog>(path, [&](const MasterStepLog& l) {
+  NodeLogScan s = scan_log<MasterStepLog>(path, [&](const MasterStepLog& l) {
     last_m = std::max(last_m, l.control_step);
     if (l.control_step < 0) return;
     ++control_rows;
@@ -285,7 +283,7 @@ NodeLogScan scan_master_log(const std::filesystem::path& path) {
 }
 
 NodeLogScan scan_slave_log(const std::filesystem::path& path) {
-  return scan_log<SlaveLogReader, SlaveStepLog>(path, [](const SlaveStepLog&) {});
+  return scan_log<SlaveStepLog>(path, [](const SlaveStepLog&) {});
 }
 
 void make_run_report_from_logs(RunReport& rep, const MasterRun* master, const std::vector<SlaveRun>& slaves,

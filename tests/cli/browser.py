@@ -8,9 +8,10 @@ python3-selenium. Importing this module exits with 77 (ctest's skip) when one of
     browser.lash_url(line)               # (url, port, token) from lash's "lash console: URL" line
 """
 import os
-import re
 import shutil
 import sys
+
+from console_run import URL_RE, lash_url  # noqa: F401  (re-exported for the tests)
 
 CHROMIUM = shutil.which("chromium")
 DRIVER = shutil.which("chromedriver") or "/usr/bin/chromedriver"
@@ -45,15 +46,6 @@ def chrome(profile):
 def severe_errors(driver):
     """The page's console messages of level SEVERE (errors) since the last call."""
     return [e for e in driver.get_log("browser") if e.get("level") == "SEVERE"]
-
-
-URL_RE = re.compile(r"lash console: (http://127\.0\.0\.1:(\d+)/\?token=([0-9a-f]{32}))$")
-
-
-def lash_url(line):
-    """(url, port, token) of lash's "lash console: URL" line, or None."""
-    m = URL_RE.search(line.strip())
-    return (m.group(1), m.group(2), m.group(3)) if m else None
 
 
 def rss_kb(pid):

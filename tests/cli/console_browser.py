@@ -24,7 +24,6 @@ import json
 import os
 import re
 import struct
-import subprocess
 import sys
 import tempfile
 import time
@@ -33,6 +32,7 @@ import urllib.request
 
 LASH = os.environ.get("LASH", "lash")
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import console_run  # noqa: E402  (the lash command with its console)
 import browser  # noqa: E402  (the shared headless chromium; exits 77 when it is missing)
 from browser import By  # noqa: E402
 
@@ -61,20 +61,10 @@ def canvas_png(driver):
 
 with tempfile.TemporaryDirectory() as tmp:
     out = os.path.join(tmp, "run")
-    run = subprocess.Popen([LASH, "hil", "run", "--duration", "50", "--console", "0", "--out-dir", out],
-                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    url = None
-    t_end = time.time() + 15
-    while time.time() < t_end and url is None:
-        line = run.stderr.readline()
-        if not line:
-            break
-        m = browser.lash_url(line)
-        if m:
-            url, port, token = m
-    if url is None:
-        run.kill()
+    run, m = console_run.start([LASH, "hil", "run", "--duration", "50", "--console", "0", "--out-dir", out])
+    if m is None:
         fail("no console URL printed")
+    url, port, token = m
     print("URL printed:", re.sub(r"token=\w+", "token=...", url))
     base = f"http://127.0.0.1:{port}"
     d = browser.chrome(os.path.join(tmp, "profile"))
@@ -180,9 +170,7 @@ with tempfile.TemporaryDirectory() as tmp:
     print("browser closed at t_run ~", round(time.time() - t_set, 1), "s after the change")
     if not mid_run:
         fail("the run had ended before the browser was closed (not a mid-run close)")
-    rest_out, rest_err = run.communicate(timeout=60)
-    if run.returncode != 0:
-        fail(f"lash hil run exited {run.returncode}: {rest_err[-2000:]}")
+    rest_out = console_run.finish(run, fail)
     print("run ended with exit 0")
     tet = re.search(r"master\s+TET \[us\] mean\s+([\d.]+)", rest_out)
     print("master TET mean", tet.group(1) if tet else "?", "us (with the console attached)")

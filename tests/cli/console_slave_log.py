@@ -9,17 +9,17 @@ state; the log's step lies within a few steps of the bus tap's Sensor_Counter at
 import csv
 import json
 import os
-import re
 import statistics
 import struct
-import subprocess
 import sys
 import tempfile
 import time
 import urllib.request
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import console_run  # noqa: E402  (the lash command with its console)
+
 LASH = os.environ.get("LASH", "lash")
-URL_RE = re.compile(r"lash console: (http://127\.0\.0\.1:(\d+)/\?token=([0-9a-f]{32}))$")
 STATES = ("startup", "connected", "running", "degraded", "safe", "failed")
 
 
@@ -35,19 +35,10 @@ def get(base, token, path):
 
 with tempfile.TemporaryDirectory() as tmp:
     out = os.path.join(tmp, "run")
-    run = subprocess.Popen([LASH, "hil", "run", "--duration", "8", "--console", "0", "--out-dir", out],
-                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    m = None
-    t_end = time.time() + 15
-    while time.time() < t_end and m is None:
-        line = run.stderr.readline()
-        if not line:
-            break
-        m = URL_RE.search(line.strip())
+    run, m = console_run.start([LASH, "hil", "run", "--duration", "8", "--console", "0", "--out-dir", out])
     if m is None:
-        run.kill()
         fail("no console URL printed")
-    base, token = f"http://127.0.0.1:{m.group(2)}", m.group(3)
+    base, token = f"http://127.0.0.1:{m[1]}", m[2]
     names = json.loads(get(base, token, "/api/meta"))["signals"]
     want = ["slave_step", "slave_log_step", "slave_log_state", "slave_log_pressure_kPa"]  # in /api/meta's order
     for n in want + ["slave_log_tet_us", "slave_log_io_us", "slave_log_wake_latency_us", "slave_log_dropped"]:
@@ -62,9 +53,7 @@ with tempfile.TemporaryDirectory() as tmp:
         frames.append(get(base, token, "/api/frame?window=2&columns=4000&sig=" + ",".join(map(str, idx))))
         st = json.loads(get(base, token, "/api/status"))
         time.sleep(0.7)
-    rest_out, rest_err = run.communicate(timeout=60)
-    if run.returncode != 0:
-        fail(f"lash hil run exited {run.returncode}: {rest_err[-2000:]}")
+    console_run.finish(run, fail)
 
     with open(os.path.join(out, "slave.csv")) as f:
         rows = {int(float(r["step"])): (float(r["state"]), float(r["pressure_kPa"])) for r in csv.DictReader(f)}

@@ -13,9 +13,11 @@
 #include "lash/hil/log_writer.hpp"
 #include "lash/hil/node_report.hpp"
 #include "lash/io/error.hpp"
+#include "hil_log_read.hpp"
 
 using namespace lash;
 using namespace lash::hil;
+using test::read_master_log;
 
 namespace {
 

@@ -1,9 +1,10 @@
 // `lash hil run`'s report computed by streaming over the nodes' CSV logs
 // (hil/report_logs.hpp) against the same report computed as the session did before, with the
-// logs read back whole into memory (read_master_log / read_slave_log, make_run_report, the
-// simulations of the ideal and of the observed schedule): the two report.json texts are equal
-// character for character (the JSON prints each double to its shortest round trip, so equal text
-// is equal bits). Besides, figures checked against hand-counted values of the schedule.
+// logs read back whole into memory (read_master_log / read_slave_log of hil_log_read.hpp,
+// make_run_report, the simulations of the ideal and of the observed schedule): the two
+// report.json texts are equal character for character (the JSON prints each double to its
+// shortest round trip, so equal text is equal bits). Besides, figures checked against
+// hand-counted values of the schedule.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -19,11 +20,14 @@
 #include "lash/hil/schedule.hpp"
 #include "lash/hil/sim_run.hpp"
 #include "lash/io/error.hpp"
+#include "hil_log_read.hpp"
 #include "hil_test_bench.hpp"
 #include "recorded_dto.hpp"
 
 using namespace lash;
 using namespace lash::hil;
+using test::read_master_log;
+using test::read_slave_log;
 
 namespace {
 

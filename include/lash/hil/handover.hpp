@@ -19,16 +19,18 @@ struct LogReadBack {
   std::size_t cut_lines = 0;   ///< an unfinished last line (the node was killed mid-write)
   double last_t_s = -1.0;      ///< t_s of the last row [s]; −1: no row
 };
-/// A node's CSV log read row by row in constant memory (what read_master_log / read_slave_log
-/// collect): next() fills the next whole row and its loop record, false at the end (a last line
-/// cut short is counted in read_back().cut_lines, not returned). Throws InputError as they do.
-class MasterLogReader {
+/// A node's CSV log read row by row in constant memory, Row = MasterStepLog (master.csv) or
+/// SlaveStepLog (slave.csv): next() fills the next whole row and its loop record, false at the
+/// end (a last line cut short is counted in read_back().cut_lines, not returned). Throws
+/// InputError as LogReadBack says.
+template <class Row>
+class LogReader {
  public:
-  explicit MasterLogReader(const std::filesystem::path& path);
-  ~MasterLogReader();
-  MasterLogReader(const MasterLogReader&) = delete;
-  MasterLogReader& operator=(const MasterLogReader&) = delete;
-  bool next(MasterStepLog& row, rt::StepRecord& record);
+  explicit LogReader(const std::filesystem::path& path);
+  ~LogReader();
+  LogReader(const LogReader&) = delete;
+  LogReader& operator=(const LogReader&) = delete;
+  bool next(Row& row, rt::StepRecord& record);
   const LogReadBack& read_back() const noexcept { return rb_; }
 
  private:
@@ -36,26 +38,10 @@ class MasterLogReader {
   std::unique_ptr<Impl> impl_;
   LogReadBack rb_;
 };
-class SlaveLogReader {
- public:
-  explicit SlaveLogReader(const std::filesystem::path& path);
-  ~SlaveLogReader();
-  SlaveLogReader(const SlaveLogReader&) = delete;
-  SlaveLogReader& operator=(const SlaveLogReader&) = delete;
-  bool next(SlaveStepLog& row, rt::StepRecord& record);
-  const LogReadBack& read_back() const noexcept { return rb_; }
-
- private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
-  LogReadBack rb_;
-};
-
-/// The whole log in memory (tests, tools): every row and its record appended to log / records.
-LogReadBack read_master_log(const std::filesystem::path& path, std::vector<MasterStepLog>& log,
-                            std::vector<rt::StepRecord>& records);
-LogReadBack read_slave_log(const std::filesystem::path& path, std::vector<SlaveStepLog>& log,
-                           std::vector<rt::StepRecord>& records);
+extern template class LogReader<MasterStepLog>;
+extern template class LogReader<SlaveStepLog>;
+using MasterLogReader = LogReader<MasterStepLog>;
+using SlaveLogReader = LogReader<SlaveStepLog>;
 
 /// Binary hand-over of a run from a node process to its session (same executable on both
 /// sides): write at the end of the run to an inherited descriptor, read back after it exited.

@@ -13,7 +13,7 @@
 /// The writer also keeps the loop statistics (TET, I/O, cycle, wake-up latency) over every row
 /// in rt::StreamSummary: a node's memory does not grow with its duration.
 /// Lines are written whole (a batch is a run of whole lines), so a reader of a killed node's
-/// log sees whole rows only (read_master_log / read_slave_log drop a cut last line anyway).
+/// log sees whole rows only (LogReader, in handover.hpp, drops a cut last line anyway).
 #include <atomic>
 #include <chrono>
 #include <cstddef>
