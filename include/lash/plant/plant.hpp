@@ -30,7 +30,7 @@ class Plant {
   /// Advances one sample: plant input v(k) → output y(k). noexcept, no allocation.
   /// A chain of up to three deadzone / deadband / first-order blocks (every plant of the thesis)
   /// runs a step compiled for its kinds (no dispatch per block); any other chain switches on each
-  /// block's kind. bench/plant_ratio.cpp holds it against hand-written eq-34 steps.
+  /// block's kind. bench/plant_ratio.cpp holds it, and run(), against hand-written eq-34 steps.
   double step(double v) noexcept { return fixed_ ? (this->*fixed_)(v) : step_any(v); }
 
   /// Steps the plant over a block of samples: y[k] = step(v[k]) for k = 0 … v.size() − 1, the
