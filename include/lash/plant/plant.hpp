@@ -33,13 +33,13 @@ class Plant {
   /// block's kind. bench/plant_ratio.cpp holds it, and run(), against hand-written eq-34 steps.
   double step(double v) noexcept { return fixed_ ? (this->*fixed_)(v) : step_any(v); }
 
-  /// Steps the plant over a block of samples: y[k] = step(v[k]) for k = 0 … v.size() − 1, the
+  /// Steps the plant over a chunk of samples: y[k] = step(v[k]) for k = 0 … v.size() − 1, the
   /// same bits as those calls (the same operations in the same order), and the plant is left as
   /// they leave it: its state, and signals() holding the blocks' outputs of the last sample (of
   /// no sample, nothing changes). A chain that step() runs compiled for its kinds runs here with
-  /// its blocks copied into locals for the whole block (the compiler keeps the state in registers
+  /// its blocks copied into locals for the whole chunk (the compiler keeps the state in registers
   /// instead of a store and a load per sample) and written back once at the end; any other chain
-  /// calls step() per sample. Blocks may follow each other: run(a) then run(b) = run(a then b).
+  /// calls step() per sample. Chunks may follow each other: run(a) then run(b) = run(a then b).
   /// y may be v (in place). Throws std::invalid_argument (before any step) unless
   /// y.size() == v.size(). No allocation.
   void run(std::span<const double> v, std::span<double> y);
