@@ -1,7 +1,9 @@
-// Plant simulation throughput: the eq-34 plant (DZ -> G -> DB), one sample per step().
+// Plant simulation throughput: the eq-34 plant (DZ -> G -> DB), one sample per step(), and a
+// chunk of 4096 samples per run(); each against a hand-written floor (bench/plant_ratio.cpp).
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -85,4 +87,55 @@ void BM_PlantEq34_FloorInMemory(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_PlantEq34_FloorInMemory);
+}  // namespace
+
+namespace {
+// run(): a chunk of 4096 samples per iteration (as `lash simulate` runs its records), the plant's
+// state in locals over the chunk. Items = samples, so 1/items_per_second is the time per sample.
+constexpr std::size_t kChunk = 4096;
+
+std::vector<double> sine_chunk() {
+  std::vector<double> v(kChunk);
+  for (std::size_t k = 0; k < v.size(); ++k) v[k] = 600.0 * std::sin(0.005 * static_cast<double>(k) * 3.0);
+  return v;
+}
+
+void BM_PlantEq34Run(benchmark::State& state) {
+  auto plant = eq34();
+  const std::vector<double> v = sine_chunk();
+  std::vector<double> y(v.size());
+  for (auto _ : state) {
+    plant.run(v, y);
+    benchmark::DoNotOptimize(y.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * kChunk));
+}
+BENCHMARK(BM_PlantEq34Run);
+
+/// The floor of run(): the hand-written eq-34 step over the same chunk loop, its state copied into
+/// a local for the chunk and written back at the end (the object lives in memory between chunks,
+/// as a Plant does).
+struct Eq34ByHandRun {
+  Eq34ByHand st;
+  void run(const double* v, double* y, std::size_t n) noexcept {
+    Eq34ByHand s = st;
+    for (std::size_t k = 0; k < n; ++k) y[k] = s.step(v[k]);
+    st = s;
+  }
+};
+
+void BM_PlantEq34Run_Floor(benchmark::State& state) {
+  auto plant = std::make_unique<Eq34ByHandRun>();
+  benchmark::DoNotOptimize(plant.get());
+  const std::vector<double> v = sine_chunk();
+  std::vector<double> y(v.size());
+  for (auto _ : state) {
+    plant->run(v.data(), y.data(), v.size());
+    benchmark::DoNotOptimize(y.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * kChunk));
+}
+BENCHMARK(BM_PlantEq34Run_Floor);
 }  // namespace

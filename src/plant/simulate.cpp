@@ -53,9 +53,30 @@ std::vector<std::string> simulation_columns(const Plant& plant) {
 
 namespace {
 
-// One sample into row[]: t, v, y (+ noise), y_true, the blocks' outputs.
-inline void step_row(Plant& plant, GaussianNoise& noise, std::size_t k, double v, double dt, double* row) {
-  const double y = plant.step(v);
+// Samples per Plant::run: the plant's state stays in registers over a chunk, and memory stays
+// bounded (a chunk of inputs, outputs and block outputs, whatever the duration).
+constexpr std::size_t kRunChunk = 4096;
+
+// Runs the plant over n samples chunk by chunk: input(k) gives v(k) (k in order), then each sample
+// of the chunk goes to put(k, v, y, x) in order of k, x the blocks' outputs. The same bits as
+// step() per sample (Plant::run).
+template <class Input, class Put>
+void run_chunked(Plant& plant, std::size_t n, Input input, Put put) {
+  if (n == 0) return;
+  const std::size_t nb = plant.blocks().size();
+  const std::size_t c = std::min(n, kRunChunk);
+  std::vector<double> v(c), y(c), x(c * nb);
+  for (std::size_t k0 = 0; k0 < n; k0 += c) {
+    const std::size_t m = std::min(c, n - k0);
+    for (std::size_t i = 0; i < m; ++i) v[i] = input(k0 + i);
+    plant.run(std::span(v).first(m), std::span(y).first(m), std::span(x).first(m * nb));
+    for (std::size_t i = 0; i < m; ++i) put(k0 + i, v[i], y[i], x.data() + i * nb);
+  }
+}
+
+// One sample into row[]: t, v, y (+ noise), y_true, the nb blocks' outputs x[].
+inline void put_row(GaussianNoise& noise, std::size_t k, double v, double y, const double* x, std::size_t nb,
+                    double dt, double* row) {
   // A finite input must give a finite output: an overflow (an amplitude of 1e308 through a
   // gain) is refused, never written as inf (a non-finite input passes through as given).
   if (!std::isfinite(y) && std::isfinite(v)) [[unlikely]]
@@ -66,8 +87,7 @@ inline void step_row(Plant& plant, GaussianNoise& noise, std::size_t k, double v
   row[1] = v;
   row[2] = y + noise.step();
   row[3] = y;
-  const auto s = plant.signals();
-  for (std::size_t i = 0; i < s.size(); ++i) row[4 + i] = s[i];
+  for (std::size_t i = 0; i < nb; ++i) row[4 + i] = x[i];
 }
 
 }  // namespace
@@ -81,12 +101,15 @@ std::size_t simulate_rows(Plant& plant, const SimulationSpec& spec, const Simula
   Signal sig(in, plant.dt_s());
   GaussianNoise noise(spec.noise_variance, noise_seed(spec.seed));
   plant.reset();
-  std::vector<double> r(4 + plant.blocks().size());
+  const std::size_t nb = plant.blocks().size();
+  std::vector<double> r(4 + nb);
   const double dt = plant.dt_s();
-  for (std::size_t k = 0; k < n; ++k) {
-    step_row(plant, noise, k, sig.next(), dt, r.data());
-    row(r);
-  }
+  run_chunked(
+      plant, n, [&](std::size_t) { return sig.next(); },
+      [&](std::size_t k, double v, double y, const double* x) {
+        put_row(noise, k, v, y, x, nb, dt, r.data());
+        row(r);
+      });
   return n;
 }
 
@@ -101,10 +124,13 @@ SimulationTrace simulate(Plant& plant, std::span<const double> v, double noise_v
   tr.names = simulation_columns(plant);
   tr.cols.assign(tr.names.size(), std::vector<double>(n));
   std::vector<double> r(tr.names.size());
-  for (std::size_t k = 0; k < n; ++k) {
-    step_row(plant, noise, k, v[k], dt, r.data());
-    for (std::size_t c = 0; c < r.size(); ++c) tr.cols[c][k] = r[c];
-  }
+  const std::size_t nb = plant.blocks().size();
+  run_chunked(
+      plant, n, [&](std::size_t k) { return v[k]; },
+      [&](std::size_t k, double vk, double y, const double* x) {
+        put_row(noise, k, vk, y, x, nb, dt, r.data());
+        for (std::size_t c = 0; c < r.size(); ++c) tr.cols[c][k] = r[c];
+      });
   return tr;
 }
 

@@ -2,9 +2,18 @@
 // §1.3.3.3 observations on the six orders of DZ, G and DB.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <iterator>
 #include <numbers>
+#include <random>
+#include <span>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "lash/io/error.hpp"
 #include "lash/plant/plant_file.hpp"
@@ -159,3 +168,132 @@ INSTANTIATE_TEST_SUITE_P(Thesis13333, SixOrders,
                            std::string n = param_info.param.file;
                            return n.substr(0, n.find('.'));
                          });
+
+// Plant::run against step(): the same bits (memcmp of the doubles), chunk boundaries anywhere.
+namespace {
+
+/// Plants of every shape step() compiles (config/plants/*.toml: the six orders of DZ, G, DB and
+/// eq. 34) plus chains of one, two and repeated kinds and two generic chains (step per block kind).
+std::vector<std::pair<std::string, Plant>> run_plants() {
+  std::vector<std::pair<std::string, Plant>> out;
+  std::vector<std::filesystem::path> files;
+  for (const auto& e : std::filesystem::directory_iterator(std::string(LASH_SOURCE_DIR) + "/config/plants"))
+    if (e.path().extension() == ".toml") files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  for (const auto& f : files) out.emplace_back(f.filename().string(), load_plant(f.string()));
+  const Deadzone dz({-300.0, 200.0});
+  const Deadband db({30.0, 50.0});
+  const FirstOrder g({{-0.96, 0.1}, {-0.94, 0.15}});
+  auto add = [&](const std::string& name, std::vector<Block> b) { out.emplace_back(name, Plant(std::move(b), 0.005)); };
+  add("dz", {dz});
+  add("db", {db});
+  add("g", {g});
+  add("g_db", {g, db});
+  add("db_db", {db, Deadband({5.0, 10.0})});
+  add("g_g_g", {g, FirstOrder({{0.5, 1.0}, {-0.5, 2.0}}), g});
+  add("dz_g_db_sat (generic)", {dz, g, db, Saturation(-20.0, 25.0)});
+  add("delay_ma_diff (generic)", {Delay(3), MovingAverage(4), BackwardDifference(0.005)});
+  return out;
+}
+
+/// A random input over both sides and through the deadzone, with exact zeros and held signs.
+std::vector<double> random_input(std::size_t n, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::vector<double> v(n);
+  double held = 0.0;
+  for (auto& x : v) {
+    const std::uint64_t r = rng();
+    const double u = static_cast<double>(r >> 11) * 0x1.0p-53;  // [0, 1)
+    switch (r & 7) {
+      case 0: x = 0.0; break;
+      case 1: x = held; break;
+      default: x = held = 1600.0 * u - 800.0;
+    }
+  }
+  return v;
+}
+
+bool same_bits(std::span<const double> a, std::span<const double> b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+}
+
+}  // namespace
+
+TEST(PlantRun, SameBitsAsStepInAnyChunks) {
+  const std::size_t n = 10000;
+  const std::vector<double> v = random_input(n, 28);
+  for (auto& [name, proto] : run_plants()) {
+    SCOPED_TRACE(name);
+    const std::size_t nb = proto.blocks().size();
+    // the reference: step() sample by sample, the blocks' outputs after each
+    Plant ref = proto;
+    ref.reset();
+    std::vector<double> y_ref(n), x_ref(n * nb);
+    for (std::size_t k = 0; k < n; ++k) {
+      y_ref[k] = ref.step(v[k]);
+      std::copy(ref.signals().begin(), ref.signals().end(), x_ref.begin() + static_cast<std::ptrdiff_t>(k * nb));
+    }
+    // run() in chunks of different sizes (an empty one too), keeping the blocks' outputs
+    Plant p = proto;
+    p.reset();
+    std::vector<double> y(n), x(n * nb);
+    const std::size_t sizes[] = {1, 2, 3, 0, 7, 4096, 1000, 1};
+    std::size_t k0 = 0;
+    for (std::size_t c = 0; k0 < n; ++c) {
+      const std::size_t m = std::min(c < std::size(sizes) ? sizes[c] : std::size_t{4096}, n - k0);
+      p.run(std::span(v).subspan(k0, m), std::span(y).subspan(k0, m), std::span(x).subspan(k0 * nb, m * nb));
+      k0 += m;
+      if (k0 > 0) {  // signals() after a run: the last sample's, as after step()
+        ASSERT_TRUE(same_bits(p.signals(), std::span(x_ref).subspan((k0 - 1) * nb, nb))) << "after sample " << k0 - 1;
+      }
+    }
+    EXPECT_TRUE(same_bits(y, y_ref));
+    EXPECT_TRUE(same_bits(x, x_ref));
+    // one run() over the record without the blocks' outputs, in place (y = v)
+    Plant q = proto;
+    q.reset();
+    std::vector<double> w = v;
+    q.run(w, w);
+    EXPECT_TRUE(same_bits(w, y_ref));
+    EXPECT_TRUE(same_bits(q.signals(), std::span(x_ref).subspan((n - 1) * nb, nb)));
+    // the state after run() is step()'s: both go on alike
+    for (std::size_t k = 0; k < 300; ++k) {
+      const double vk = 700.0 * std::sin(0.01 * static_cast<double>(k));
+      const double a = ref.step(vk), b = q.step(vk), c = p.step(vk);
+      ASSERT_TRUE(same_bits(std::span(&a, 1), std::span(&b, 1)) && same_bits(std::span(&a, 1), std::span(&c, 1)))
+          << "k = " << k;
+    }
+  }
+}
+
+TEST(PlantRun, RefusesMismatchedSpans) {
+  Plant p = load_plant(cfg("thesis_eq34.toml"));
+  std::vector<double> v(10), y(9), x(29);
+  EXPECT_THROW(p.run(v, y), std::invalid_argument);
+  y.resize(10);
+  EXPECT_THROW(p.run(v, y, x), std::invalid_argument);
+  // nothing was stepped: the plant is still at its zero state
+  Plant fresh = load_plant(cfg("thesis_eq34.toml"));
+  for (int k = 0; k < 50; ++k) ASSERT_EQ(p.step(600.0), fresh.step(600.0));
+}
+
+TEST(Simulate, RecordInChunksSameBitsAsStep) {
+  // simulate() runs the plant chunk by chunk (Plant::run); its columns against step() per sample
+  // over a record of several chunks (10000 samples = 2 chunks of 4096 + 1808).
+  const std::vector<double> v = random_input(10000, 34);
+  for (auto& [name, proto] : run_plants()) {
+    SCOPED_TRACE(name);
+    Plant p = proto, ref = proto;
+    ref.reset();
+    const SimulationTrace tr = simulate(p, v, 0.0, 1);
+    const std::size_t nb = proto.blocks().size();
+    std::vector<double> y(v.size());
+    std::vector<std::vector<double>> x(nb, std::vector<double>(v.size()));
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      y[k] = ref.step(v[k]);
+      for (std::size_t i = 0; i < nb; ++i) x[i][k] = ref.signals()[i];
+    }
+    EXPECT_TRUE(same_bits(tr.col("y_true"), y));
+    for (std::size_t i = 0; i < nb; ++i) EXPECT_TRUE(same_bits(tr.cols[4 + i], x[i])) << tr.names[4 + i];
+  }
+}

@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <span>
 #include <string>
+#include <type_traits>
 #include <variant>
 #include <vector>
 
@@ -29,8 +30,23 @@ class Plant {
   /// Advances one sample: plant input v(k) → output y(k). noexcept, no allocation.
   /// A chain of up to three deadzone / deadband / first-order blocks (every plant of the thesis)
   /// runs a step compiled for its kinds (no dispatch per block); any other chain switches on each
-  /// block's kind. bench/plant_ratio.cpp holds it against hand-written eq-34 steps.
+  /// block's kind. bench/plant_ratio.cpp holds it, and run(), against hand-written eq-34 steps.
   double step(double v) noexcept { return fixed_ ? (this->*fixed_)(v) : step_any(v); }
+
+  /// Steps the plant over a chunk of samples: y[k] = step(v[k]) for k = 0 … v.size() − 1, the
+  /// same bits as those calls (the same operations in the same order), and the plant is left as
+  /// they leave it: its state, and signals() holding the blocks' outputs of the last sample (of
+  /// no sample, nothing changes). A chain that step() runs compiled for its kinds runs here with
+  /// its blocks copied into locals for the whole chunk (the compiler keeps the state in registers
+  /// instead of a store and a load per sample) and written back once at the end; any other chain
+  /// calls step() per sample. Chunks may follow each other: run(a) then run(b) = run(a then b).
+  /// y may be v (in place). Throws std::invalid_argument (before any step) unless
+  /// y.size() == v.size(). No allocation.
+  void run(std::span<const double> v, std::span<double> y);
+  /// run(v, y) that also keeps every block's output of every sample: x[k·blocks().size() + i] is
+  /// signals()[i] after step(v[k]). Throws std::invalid_argument unless
+  /// x.size() == v.size()·blocks().size().
+  void run(std::span<const double> v, std::span<double> y, std::span<double> x);
 
   /// Output of each block at the last step (same order as blocks()).
   std::span<const double> signals() const noexcept { return signals_; }
@@ -59,15 +75,24 @@ class Plant {
     v_prev_ = v;
     return x;
   }
+  /// Block b as its kind I: compiled_for chose the fixed step and run for exactly these kinds, and
+  /// a block never changes its kind (blocks() is const): no check of the variant's index.
+  template <std::size_t I>
+  static std::variant_alternative_t<I, Block>& as_kind(Block& b) noexcept {
+    auto* blk = std::get_if<I>(&b);
+    if (!blk) __builtin_unreachable();
+    return *blk;
+  }
+  /// One step of a deadzone, deadband or first-order block (the kinds 0, 1, 2).
+  template <class B>
+  static double step_block(B& blk, double x, Side side) noexcept {
+    if constexpr (std::is_same_v<B, Deadzone>) return blk.step(x);
+    else return blk.step(x, side);
+  }
   /// One block of kind I (0 deadzone, 1 deadband, 2 first order) without a dispatch.
   template <std::size_t I>
   static double step_kind(Block& b, double x, Side side) noexcept {
-    auto* blk = std::get_if<I>(&b);
-    // fixed_step_for chose this step for exactly these kinds, and a block never changes its kind
-    // (blocks() is const): no check of the variant's index on the sample path
-    if (!blk) __builtin_unreachable();
-    if constexpr (I == 0) return blk->step(x);
-    else return blk->step(x, side);
+    return step_block(as_kind<I>(b), x, side);
   }
   /// The step of a chain whose kinds are I... (in order), each block's step inlined.
   template <std::size_t... I>
@@ -80,10 +105,26 @@ class Plant {
     v_prev_ = v;
     return x;
   }
+  /// run() of a chain whose kinds are I... over n samples, the blocks copied into locals; with
+  /// Keep, every block's output of every sample into x (defined in plant.cpp, its only user).
+  template <bool Keep, std::size_t... I>
+  void run_fixed(const double* v, double* y, double* x, std::size_t n) noexcept;
+  /// run() of any chain: step() per sample (x may be null).
+  void run_any(const double* v, double* y, double* x, std::size_t n) noexcept;
+
   using StepFn = double (Plant::*)(double) noexcept;
-  static StepFn fixed_step_for(const std::vector<Block>& blocks) noexcept;
+  using RunFn = void (Plant::*)(const double*, double*, double*, std::size_t) noexcept;
+  struct Compiled {
+    StepFn step = nullptr;
+    RunFn run = nullptr;       ///< without the blocks' outputs
+    RunFn run_keep = nullptr;  ///< with them
+  };
+  /// The step and runs compiled for the chain's kinds, or nulls (the chain takes the generic path).
+  static Compiled compiled_for(const std::vector<Block>& blocks) noexcept;
 
   StepFn fixed_ = nullptr;
+  RunFn run_ = nullptr;
+  RunFn run_keep_ = nullptr;
   std::vector<Block> blocks_;
   std::vector<double> signals_;
   double dt_s_;

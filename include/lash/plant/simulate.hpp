@@ -2,8 +2,9 @@
 /// @file simulate.hpp
 /// Open-loop simulation of a plant driven by a signal, with optional additive
 /// Gaussian measurement noise on y. Not real-time safe (allocates the trace).
-/// simulate_rows() keeps nothing: each sample goes to a callback as it is produced (memory
-/// O(1) in the duration), which is how `lash simulate` writes its CSV.
+/// simulate_rows() keeps nothing: the plant runs in chunks of 4096 samples (Plant::run, the
+/// same bits as step() per sample) and each sample of a chunk goes to a callback (memory O(1) in
+/// the duration), which is how `lash simulate` writes its CSV.
 #include <cstdint>
 #include <functional>
 #include <span>
