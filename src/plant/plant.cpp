@@ -107,15 +107,12 @@ Plant::Compiled Plant::compiled_for(const std::vector<Block>& blocks) noexcept {
 Plant::Plant(std::vector<Block> blocks, double dt_s) : blocks_(std::move(blocks)), dt_s_(dt_s) {
   if (!(std::isfinite(dt_s) && dt_s > 0)) throw std::invalid_argument("dt must be > 0");
   signals_.assign(blocks_.size(), 0.0);
-  const Compiled f = compiled_for(blocks_);
-  fixed_ = f.step;
-  run_ = f.run;
-  run_keep_ = f.run_keep;
+  compiled_ = compiled_for(blocks_);
 }
 
 void Plant::run(std::span<const double> v, std::span<double> y) {
   if (y.size() != v.size()) throw std::invalid_argument("run: y must have as many samples as v");
-  if (run_) (this->*run_)(v.data(), y.data(), nullptr, v.size());
+  if (compiled_.run) (this->*compiled_.run)(v.data(), y.data(), nullptr, v.size());
   else run_any(v.data(), y.data(), nullptr, v.size());
 }
 
@@ -123,7 +120,7 @@ void Plant::run(std::span<const double> v, std::span<double> y, std::span<double
   if (y.size() != v.size()) throw std::invalid_argument("run: y must have as many samples as v");
   if (x.size() != v.size() * blocks_.size())
     throw std::invalid_argument("run: x must hold every block's output of every sample (v.size() x blocks)");
-  if (run_keep_) (this->*run_keep_)(v.data(), y.data(), x.data(), v.size());
+  if (compiled_.run_keep) (this->*compiled_.run_keep)(v.data(), y.data(), x.data(), v.size());
   else run_any(v.data(), y.data(), x.data(), v.size());
 }
 

@@ -31,7 +31,7 @@ class Plant {
   /// A chain of up to three deadzone / deadband / first-order blocks (every plant of the thesis)
   /// runs a step compiled for its kinds (no dispatch per block); any other chain switches on each
   /// block's kind. bench/plant_ratio.cpp holds it, and run(), against hand-written eq-34 steps.
-  double step(double v) noexcept { return fixed_ ? (this->*fixed_)(v) : step_any(v); }
+  double step(double v) noexcept { return compiled_.step ? (this->*compiled_.step)(v) : step_any(v); }
 
   /// Steps the plant over a chunk of samples: y[k] = step(v[k]) for k = 0 … v.size() − 1, the
   /// same bits as those calls (the same operations in the same order), and the plant is left as
@@ -122,9 +122,7 @@ class Plant {
   /// The step and runs compiled for the chain's kinds, or nulls (the chain takes the generic path).
   static Compiled compiled_for(const std::vector<Block>& blocks) noexcept;
 
-  StepFn fixed_ = nullptr;
-  RunFn run_ = nullptr;
-  RunFn run_keep_ = nullptr;
+  Compiled compiled_;  ///< null members: a chain compiled_for has no step for
   std::vector<Block> blocks_;
   std::vector<double> signals_;
   double dt_s_;
