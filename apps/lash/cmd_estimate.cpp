@@ -1,5 +1,7 @@
 // lash estimate: run one of the switching estimators of docs/method.md §A4 over a recorded t,v,y file.
 #include <algorithm>
+#include <cerrno>
+#include <cstdlib>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -11,6 +13,7 @@
 #include <fmt/core.h>
 
 #include "cli_common.hpp"
+#include "csv_stream.hpp"
 #include "estimate_plot.hpp"
 #include "estimate_settings.hpp"
 #include "plot.hpp"
@@ -43,29 +46,100 @@ std::map<std::string, std::pair<double, double>> ci95_columns(const EstimateRepo
   return m;
 }
 
+/// Rows of a record `lash estimate` holds in memory; a longer record is read into a temporary
+/// file and estimated from there in chunks (docs/memory.md). LASH_SPILL_ROWS overrides it.
+std::size_t spill_after_rows() {
+  constexpr std::size_t kDefault = std::size_t{1} << 20;  // 24 MiB of t, v, y
+  const char* env = std::getenv("LASH_SPILL_ROWS");
+  if (!env || !*env) return kDefault;
+  char* end = nullptr;
+  errno = 0;
+  const unsigned long long n = std::strtoull(env, &end, 10);
+  if (errno != 0 || *end != '\0' || n == 0 || env[0] == '-')
+    throw InputError("", 0, "LASH_SPILL_ROWS", std::string("expected a positive number of rows, got '") +
+                                                   std::string(env).substr(0, 40) + "'");
+  return static_cast<std::size_t>(n);
+}
+
+/// The trace (t, y, ŷ, y_sim and every parameter per step) written to a CSV as the final run goes:
+/// nothing per sample is kept in memory. Remembers which parameters never had a finite value.
+class TraceWriter {
+ public:
+  TraceWriter(const std::string& path, std::vector<std::string> names, const ColumnStore& store)
+      : csv_(path, names), store_(store), row_(names.size()), finite_(names.size() - 4, false) {}
+  void operator()(const TraceRow& r) {
+    if (r.k - t_base_ >= t_.size()) {  // the next chunk of t (views when the record is in memory)
+      t_base_ = r.k;
+      t_ = t_buf_.get(store_, {0}, r.k, std::min(ColumnStore::kChunkRows, store_.rows() - r.k))[0];
+    }
+    row_[0] = t_[r.k - t_base_];
+    row_[1] = r.y;
+    row_[2] = r.yhat;
+    row_[3] = r.ysim;
+    for (std::size_t p = 0; p < r.params.size() && p + 4 < row_.size(); ++p) {
+      row_[p + 4] = r.params[p];
+      if (std::isfinite(r.params[p])) finite_[p] = true;
+    }
+    csv_.row(row_);
+  }
+  void commit() { csv_.commit(); }
+  bool ever_finite(std::size_t p) const { return finite_[p]; }
+
+ private:
+  CsvStream csv_;
+  const ColumnStore& store_;
+  ChunkBuffer<1> t_buf_;
+  std::span<const double> t_;
+  std::size_t t_base_ = 0;
+  std::vector<double> row_;
+  std::vector<bool> finite_;
+};
+
 int run(const CLI::App& sub, const EstimateOptions& o) {
   const SettingsSources src = settings_sources(sub, o);
   // settings are checked before the data is read, so a bad option never costs a file scan
   const EstimationJob job = resolve_settings(src).job;
-  const Record rec = load_record(o.data, job.columns, o.strict);
-  if (src.nrmse_window_s && !rec.t().empty() && job.nrmse_t0_s >= rec.t().back())
+  const std::size_t spill_rows = spill_after_rows();
+  const Record rec = load_record(o.data, job.columns, o.strict, spill_rows);
+  const RecordColumns cols = rec.columns();
+  const double t_last = cols.store.back(0);
+  if (src.nrmse_window_s && job.nrmse_t0_s >= t_last)
     throw InputError(o.data, 0, "--nrmse-window",
                      "T0 = " + format_double(job.nrmse_t0_s) + " s is not before the record's end (" +
-                         format_double(rec.t().back()) + " s)");
+                         format_double(t_last) + " s)");
   ArrayEstimateOptions eo;
-  eo.trace = !o.out.empty() || !o.plot.empty();
-  eo.outputs = eo.trace;  // ŷ and y_sim per sample only for the trace (the NRMSE is summed in the run)
+  eo.trace = false;    // the trace is streamed to its file (TraceWriter), never held
+  eo.outputs = false;  // ŷ and y_sim per sample: in the streamed trace (the NRMSE is summed in the run)
   eo.outlier_gate = o.outlier_gate;
   eo.sampling = &rec.sampling;
   eo.rows_skipped = rec.skipped_rows();
   eo.first_skipped_line = rec.data.first_skipped_line;
-  const ArrayEstimate e = estimate_arrays(src, rec.t(), rec.v(), rec.y(), eo);
+  // The trace file: -o, or (for --plot alone) one in a fresh private directory (mkdtemp). A trace
+  // that cannot be opened does not stop the estimate: the result is printed first, the error after.
+  std::optional<PrivateTempDir> tmp;
+  std::optional<TraceWriter> trace;
+  std::optional<InputError> trace_error;
+  std::string csv = o.out;
+  if (!o.out.empty() || !o.plot.empty()) {
+    try {
+      if (csv.empty()) {
+        tmp.emplace(o.plot, "--plot");
+        csv = (tmp->path() / "trace.csv").string();
+      }
+      std::vector<std::string> names{"t", "y", "yhat", "y_sim"};
+      for (const auto& n : param_names(model_traits(resolve_settings(src).cfg.model))) names.push_back(n);
+      trace.emplace(csv, std::move(names), cols.store);
+      eo.on_step = [&trace](const TraceRow& r) { (*trace)(r); };
+    } catch (const InputError& e) {
+      trace_error = e;
+    }
+  }
+  const ArrayEstimate e = estimate_record(src, cols, eo);
   const EstimationRun& run = e.run.run;
   if (o.timing)
     fmt::print(stderr, "lash estimate: estimator ran {} samples in {} s ({:.3g} M samples/s; CPU time {} s)\n",
-               rec.v().size(), format_double(e.estimator_s), static_cast<double>(rec.v().size()) / e.estimator_s * 1e-6,
+               rec.rows(), format_double(e.estimator_s), static_cast<double>(rec.rows()) / e.estimator_s * 1e-6,
                format_double(e.estimator_cpu_s));
-  const auto& t = rec.t();
   if (o.print_config) {
     fmt::print("{}", config_to_toml(e.run.cfg, &e.job));
     return kExitOk;
@@ -76,32 +150,18 @@ int run(const CLI::App& sub, const EstimateOptions& o) {
   else
     fmt::print("{}", estimate_auto_text(e.run, e.result.dt_s, e.fit));
   std::fflush(stdout);
-  // the trace: t, y, yhat, y_sim and every parameter per step
-  std::vector<std::string> names{"t", "y", "yhat", "y_sim"};
-  std::vector<const std::vector<double>*> cols{&t, &rec.y(), &run.yhat, &run.ysim};
-  for (std::size_t p = 0; p < run.param_names.size(); ++p) {
-    names.push_back(run.param_names[p]);
-    cols.push_back(&run.params[p]);
-  }
-  if (!o.out.empty()) write_columns_csv(o.out, names, cols);
+  if (trace_error) throw *trace_error;
+  if (!trace) return kExitOk;
+  trace->commit();
   if (!o.plot.empty()) {
     std::set<std::string> empty;  // columns without a finite value: a side never identified
     for (std::size_t p = 0; p < run.param_names.size(); ++p)
-      if (std::none_of(run.params[p].begin(), run.params[p].end(), [](double x) { return std::isfinite(x); }))
-        empty.insert(run.param_names[p]);
-    std::string csv = o.out;
-    std::optional<PrivateTempDir> tmp;  // without -o: the trace in a fresh private directory (mkdtemp)
-    if (csv.empty()) {
-      tmp.emplace(o.plot, "--plot");
-      csv = (tmp->path() / "trace.csv").string();
-      write_columns_csv(csv, names, cols);
-    }
+      if (!trace->ever_finite(p)) empty.insert(run.param_names[p]);
     plot_estimate(csv, o.plot,
                   fmt::format("lash estimate --model {} {}", to_string(e.run.cfg.model),
                               std::filesystem::path(o.data).filename().string()),
-                  run.param_names, t.back(), ci95_columns(run.report), empty);
+                  run.param_names, t_last, ci95_columns(run.report), empty);
   }
-
   return kExitOk;
 }
 

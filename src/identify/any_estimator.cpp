@@ -88,12 +88,26 @@ EstimateReport AnyEstimator::report() const {
   return rep;
 }
 
-EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> v, std::span<const double> y,
-                            const RunOptions& o) {
+RecordColumns RecordColumns::of(std::span<const double> v, std::span<const double> y) {
   if (v.size() != y.size()) throw std::invalid_argument("v and y differ in length");
+  RecordColumns r;
+  r.store = ColumnStore({v, y});
+  return r;
+}
+
+RecordColumns RecordColumns::of(std::span<const double> t, std::span<const double> v, std::span<const double> y) {
+  if (v.size() != y.size() || t.size() != v.size()) throw std::invalid_argument("t, v and y differ in length");
+  RecordColumns r;
+  r.store = ColumnStore({t, v, y});
+  r.t = 0;
+  r.vy = {1, 2};
+  return r;
+}
+
+EstimationRun run_estimator(const EstimatorConfig& cfg, const RecordColumns& rec, const RunOptions& o) {
   AnyEstimator est(cfg);
   EstimationRun run;
-  const std::size_t n = v.size();
+  const std::size_t n = rec.size();
   if (o.keep_outputs) {
     run.yhat.reserve(n);  // filled in step order below: no zero-filling pass over 2 x n doubles first
     run.ysim.reserve(n);
@@ -104,21 +118,28 @@ EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> 
   const std::size_t s0 = std::min(o.score_begin, n), s1 = std::min(std::max(o.score_end, s0), n);
   NrmseAccumulator score;
   // the score reads y as given (an edited row's own value: the edits live apart from y)
-  step_through(est, v, y, 0, n, o.gap_rows, [&](std::size_t k, const auto& e) {
+  step_through(est, rec, 0, n, o.gap_rows, [&](std::size_t k, double yk, const auto& e) {
     if (o.keep_outputs) {
       run.yhat.push_back(e.prediction());  // k = run.yhat.size(): step_through goes 0, 1, ..., n - 1
       run.ysim.push_back(e.simulated());
     }
-    if (k - s0 < s1 - s0) score.add(y[k], e.simulated());  // s0 <= k < s1
-    if (o.keep_trace) {
+    if (k - s0 < s1 - s0) score.add(yk, e.simulated());  // s0 <= k < s1
+    if (o.keep_trace || o.on_step) {
       est.param_values(pv);
-      for (std::size_t p = 0; p < pv.size(); ++p) run.params[p][k] = pv[p];
+      if (o.keep_trace)
+        for (std::size_t p = 0; p < pv.size(); ++p) run.params[p][k] = pv[p];
+      if (o.on_step) o.on_step(TraceRow{k, yk, e.prediction(), e.simulated(), pv});
     }
   }, o.y_edits);
   run.score = score;
   run.report = est.report();
   if (o.at_end) o.at_end(est);
   return run;
+}
+
+EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> v, std::span<const double> y,
+                            const RunOptions& o) {
+  return run_estimator(cfg, RecordColumns::of(v, y), o);
 }
 
 EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> v, std::span<const double> y,
@@ -131,11 +152,16 @@ EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> 
   return run_estimator(cfg, v, y, o);
 }
 
-void add_intervals(EstimationRun& run, const EstimatorConfig& cfg, std::span<const double> v,
-                   std::span<const double> y, std::span<const std::size_t> gap_rows) {
+void add_intervals(EstimationRun& run, const EstimatorConfig& cfg, const RecordColumns& rec,
+                   std::span<const std::size_t> gap_rows) {
   IntervalSettings s;
   s.gap_rows = gap_rows;
-  attach_intervals(run.report, batch_means_intervals(cfg, v, y, {run.report.right.params, run.report.left.params}, s));
+  attach_intervals(run.report, batch_means_intervals(cfg, rec, {run.report.right.params, run.report.left.params}, s));
+}
+
+void add_intervals(EstimationRun& run, const EstimatorConfig& cfg, std::span<const double> v,
+                   std::span<const double> y, std::span<const std::size_t> gap_rows) {
+  add_intervals(run, cfg, RecordColumns::of(v, y), gap_rows);
 }
 
 void attach_intervals(EstimateReport& rep, const PerSide<SideIntervals>& ci) {

@@ -183,14 +183,21 @@ EstimatorConfig preset_config(ModelKind model, Preset preset, double dt_s) {
 // the sequence), in memory of a few per cent of the record: see Selection and
 // docs/identification.md ("Defaults chosen from the data").
 DataTraits analyse_record(std::span<const double> v, std::span<const double> y, double dt_s, YEdits ed) {
+  const std::size_t n = std::min(v.size(), y.size());
+  return analyse_record(RecordColumns::of(v.first(n), y.first(n)), dt_s, ed);
+}
+
+DataTraits analyse_record(const RecordColumns& rec, double dt_s, YEdits ed) {
   DataTraits d;
   d.dt_s = dt_s;
-  const std::size_t n = std::min(v.size(), y.size());
+  const std::size_t n = rec.size();
   // y as the estimators see it: y[i], or the edit's value at an edited row (by bisection; the
-  // passes below walk the edits with a cursor instead)
-  const auto y_at = [&](std::size_t i) {
+  // passes below walk the edits with a cursor instead); the rows of a window [k0, k0 + m) are read
+  // into `win` (views of a record in memory)
+  ChunkBuffer<2> win;
+  const auto y_at = [&](std::size_t i, double yi) {
     const auto it = std::lower_bound(ed.rows.begin(), ed.rows.end(), i);
-    return it != ed.rows.end() && *it == i ? ed.values[static_cast<std::size_t>(it - ed.rows.begin())] : y[i];
+    return it != ed.rows.end() && *it == i ? ed.values[static_cast<std::size_t>(it - ed.rows.begin())] : yi;
   };
   constexpr std::size_t kNoEdit = static_cast<std::size_t>(-1);
   // The five sequences' quantiles (index of the sequence, q)
@@ -211,13 +218,15 @@ DataTraits analyse_record(std::span<const double> v, std::span<const double> y, 
         rng = rng * 6364136223846793005ULL + 1442695040888963407ULL;
         const double u = static_cast<double>(rng >> 11) * 0x1p-53;
         const std::size_t k = std::min(n - 1, 40 + static_cast<std::size_t>((static_cast<double>(j) + u) * stratum));
+        const auto w = win.get(rec.store, rec.vy, k - 40, 41);
+        const auto vw = w[0], yw = w[1];  // vw[i], yw[i]: row k − 40 + i
         bool ok = true;
-        for (std::size_t i = k - 40; i <= k; ++i) ok = ok && std::isfinite(v[i]) && std::isfinite(y_at(i));
+        for (std::size_t i = 0; i <= 40; ++i) ok = ok && std::isfinite(vw[i]) && std::isfinite(y_at(k - 40 + i, yw[i]));
         if (!ok) continue;
         Streams s{dt_s};
-        for (std::size_t i = k - 40; i <= k; ++i)
-          s.push(v[i], y_at(i), [&](int idx, double x) {
-            if (i == k) smp[static_cast<std::size_t>(idx)].push_back(x);
+        for (std::size_t i = 0; i <= 40; ++i)
+          s.push(vw[i], y_at(k - 40 + i, yw[i]), [&](int idx, double x) {
+            if (i == 40) smp[static_cast<std::size_t>(idx)].push_back(x);
           });
       }
     }
@@ -238,11 +247,15 @@ DataTraits analyse_record(std::span<const double> v, std::span<const double> y, 
   const auto pass = [&](unsigned active, bool first) {
     std::size_t k = 0;  // finite pairs before the chunk
     std::size_t e = 0, next_edit = ed.rows.empty() ? kNoEdit : ed.rows[0];
-    for (std::size_t r = 0; r < n;) {
+    // the record in chunks of rows (views when in memory); r counts rows of the whole record
+    for_chunks(rec.store, rec.vy, 0, n, [&](std::size_t base, const auto& cols) {
+    const std::span<const double> v = cols[0], y = cols[1];
+    const std::size_t n_rows = v.size();
+    for (std::size_t r = 0; r < n_rows;) {
       std::size_t m = 0;
-      for (; r < n && m < kChunk; ++r) {
+      for (; r < n_rows && m < kChunk; ++r) {
         double yr = y[r];
-        if (r == next_edit) [[unlikely]] {
+        if (base + r == next_edit) [[unlikely]] {
           yr = ed.values[e++];
           next_edit = e < ed.rows.size() ? ed.rows[e] : kNoEdit;
         }
@@ -282,6 +295,7 @@ DataTraits analyse_record(std::span<const double> v, std::span<const double> y, 
         std::copy(from, from + static_cast<std::ptrdiff_t>(kLead), yb.begin());
       }
     }
+    });
     return k;
   };
   const std::size_t k = pass(0x7Fu, true);
@@ -328,19 +342,23 @@ DataTraits analyse_record(std::span<const double> v, std::span<const double> y, 
     double y_prev = 0.0;
     const std::size_t n_all = n;
     std::size_t e = 0, next_edit = ed.rows.empty() ? kNoEdit : ed.rows[0];
-    for (std::size_t i = 0; i < n_all && off <= off_allowed; ++i) {
-      double yi = y[i];
-      if (i == next_edit) [[unlikely]] {
-        yi = ed.values[e++];
-        next_edit = e < ed.rows.size() ? ed.rows[e] : kNoEdit;
+    for_chunks(rec.store, rec.vy, 0, n_all, [&](std::size_t base, const auto& cols) {
+      const std::span<const double> v = cols[0], y = cols[1];
+      for (std::size_t j = 0; j < v.size() && off <= off_allowed; ++j) {
+        const std::size_t i = base + j;
+        double yi = y[j];
+        if (i == next_edit) [[unlikely]] {
+          yi = ed.values[e++];
+          next_edit = e < ed.rows.size() ? ed.rows[e] : kNoEdit;
+        }
+        if (!(std::isfinite(v[j]) && std::isfinite(yi))) continue;
+        if (seen++ >= 1) {
+          const double s = std::fabs(yi - y_prev);
+          if (s > 0.0) off += std::fabs(s / q - std::round(s / q)) < 1e-3 ? 0u : 1u;
+        }
+        y_prev = yi;
       }
-      if (!(std::isfinite(v[i]) && std::isfinite(yi))) continue;
-      if (seen++ >= 1) {
-        const double s = std::fabs(yi - y_prev);
-        if (s > 0.0) off += std::fabs(s / q - std::round(s / q)) < 1e-3 ? 0u : 1u;
-      }
-      y_prev = yi;
-    }
+    });
     if (off <= off_allowed) d.quantum = q;
   }
   return d;
@@ -354,23 +372,49 @@ void tune_to_data(EstimatorConfig& c, const DataTraits& d) {
 
 void gate_outliers(std::span<const double> y, double gate, std::vector<std::size_t>& rows,
                    std::vector<double>& values) {
+  gate_outliers(RecordColumns::of(y, y), gate, rows, values);
+}
+
+void gate_outliers(const RecordColumns& rec, double gate, std::vector<std::size_t>& rows,
+                   std::vector<double>& values) {
   if (!(gate > 0.0)) return;
   OutlierGateConfig gc;
   gc.gate = gate;
   OutlierGate gate_y(gc);
-  for (std::size_t k = 0; k < y.size(); ++k) {
-    const std::uint64_t before = gate_y.rejected();
-    const double g = gate_y.step(y[k]);
-    if (gate_y.rejected() == before) continue;  // accepted: g is y[k]
-    const double next = k + 1 < y.size() ? y[k + 1] : g;
-    if (std::fabs(next - y[k]) < std::fabs(next - g)) continue;  // a true step: y[k] stays
-    rows.push_back(k);
-    values.push_back(g);
-  }
+  // A flagged sample is decided when its successor is read: one sample is held back across chunks.
+  bool held = false;
+  std::size_t held_k = 0;
+  double held_y = 0.0, held_g = 0.0;
+  const auto decide = [&](double next) {
+    if (std::fabs(next - held_y) < std::fabs(next - held_g)) return;  // a true step: y[k] stays
+    rows.push_back(held_k);
+    values.push_back(held_g);
+  };
+  for_chunks(rec.store, std::array<std::size_t, 1>{rec.vy[1]}, 0, rec.size(), [&](std::size_t base, const auto& c) {
+    const std::span<const double> y = c[0];
+    for (std::size_t j = 0; j < y.size(); ++j) {
+      if (held) {
+        decide(y[j]);
+        held = false;
+      }
+      const std::uint64_t before = gate_y.rejected();
+      const double g = gate_y.step(y[j]);
+      if (gate_y.rejected() == before) continue;  // accepted: g is y[k]
+      held = true;
+      held_k = base + j;
+      held_y = y[j];
+      held_g = g;
+    }
+  });
+  if (held) decide(held_g);  // the last sample: no successor (compared with itself: replaced)
 }
 
 AutoRun estimate_auto(const EstimatorConfig& cfg0, std::span<const double> v, std::span<const double> y,
                       const AutoOptions& o) {
+  return estimate_auto(cfg0, RecordColumns::of(v, y), o);
+}
+
+AutoRun estimate_auto(const EstimatorConfig& cfg0, const RecordColumns& rec, const AutoOptions& o) {
   AutoRun out;
   // The gate is causal (usable online); over a whole record the sample after a flagged one is also
   // known: when it lies nearer the flagged value than the last accepted one, the output really
@@ -378,7 +422,7 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, std::span<const double> v, st
   // The replaced samples are kept apart from y (YEdits): no copy of the record.
   std::vector<std::size_t> edit_rows;
   std::vector<double> edit_values;
-  gate_outliers(y, o.gate, edit_rows, edit_values);
+  gate_outliers(rec, o.gate, edit_rows, edit_values);
   out.outliers = edit_rows.size();
   const YEdits edits{edit_rows, edit_values};
   out.cfg = cfg0;
@@ -386,7 +430,7 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, std::span<const double> v, st
   const bool search_r = uses_guesses(cfg.model) && std::isinf(cfg.guess_right);
   const bool search_l = uses_guesses(cfg.model) && std::isinf(cfg.guess_left);
   if (search_r || search_l) {
-    const auto g = search_guesses(cfg, v, y, o.gap_rows, edits,
+    const auto g = search_guesses(cfg, rec, o.gap_rows, edits,
                                   edit_rows.empty() && o.traits && o.traits->dt_s == cfg.dt_s ? o.traits : nullptr);
     if (search_r) cfg.guess_right = g[0];
     if (search_l) cfg.guess_left = g[1];
@@ -399,12 +443,13 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, std::span<const double> v, st
   ro.y_edits = edits;
   ro.score_begin = o.score_begin;
   ro.score_end = o.score_end;
+  ro.on_step = o.on_step;
   ro.at_end = [&](const AnyEstimator& est) {
     if (!uses_guesses(cfg.model)) return;
     out.right.edge = est.raw_edge(Side::right);
     out.left.edge = est.raw_edge(Side::left);
   };
-  out.run = run_estimator(cfg, v, y, ro);
+  out.run = run_estimator(cfg, rec, ro);
   if (uses_guesses(cfg.model)) {
     out.right.guess = cfg.guess_right;
     out.left.guess = cfg.guess_left;
@@ -428,8 +473,14 @@ AutoRun estimate_auto(const EstimatorConfig& cfg, std::span<const double> v, std
 std::array<double, 2> search_guesses(const EstimatorConfig& cfg0, std::span<const double> v,
                                      std::span<const double> y, std::span<const std::size_t> gap_rows,
                                      YEdits edits, const DataTraits* traits) {
+  const std::size_t n = std::min(v.size(), y.size());
+  return search_guesses(cfg0, RecordColumns::of(v.first(n), y.first(n)), gap_rows, edits, traits);
+}
+
+std::array<double, 2> search_guesses(const EstimatorConfig& cfg0, const RecordColumns& rec,
+                                     std::span<const std::size_t> gap_rows, YEdits edits, const DataTraits* traits) {
   if (!uses_guesses(cfg0.model)) return {kInf, -kInf};
-  const DataTraits d = traits ? *traits : analyse_record(v, y, cfg0.dt_s, edits);
+  const DataTraits d = traits ? *traits : analyse_record(rec, cfg0.dt_s, edits);
   const double hi = std::max(d.v_hi, 0.0), lo = std::min(d.v_lo, 0.0);
   const double span = hi - lo;
   std::array<double, 2> g{0.7 * hi, 0.7 * lo};
@@ -439,7 +490,7 @@ std::array<double, 2> search_guesses(const EstimatorConfig& cfg0, std::span<cons
     cfg.guess_right = g[0] > 0.0 ? g[0] : kInf;
     cfg.guess_left = g[1] < 0.0 ? g[1] : -kInf;
     AnyEstimator est(cfg);
-    step_through(est, v, y, 0, v.size(), gap_rows, [](std::size_t, const auto&) {}, edits);
+    step_through(est, rec, 0, rec.size(), gap_rows, [](std::size_t, double, const auto&) {}, edits);
     std::array<double, 2> next = g;
     for (int i = 0; i < 2; ++i) {
       const Side s = i == 0 ? Side::right : Side::left;

@@ -31,6 +31,13 @@ void refuse_unused_keys(const toml::table& tbl, const std::string& origin, Model
 
 EstimateSettings resolve_settings(const SettingsSources& src, double dt_s, std::span<const double> v,
                                   std::span<const double> y) {
+  if (v.empty()) return resolve_settings(src, dt_s, nullptr);
+  const std::size_t n = std::min(v.size(), y.size());
+  const RecordColumns rec = RecordColumns::of(v.first(n), y.first(n));
+  return resolve_settings(src, dt_s, &rec);
+}
+
+EstimateSettings resolve_settings(const SettingsSources& src, double dt_s, const RecordColumns* record) {
   EstimateSettings out;
   std::optional<toml::table> file;
   if (!src.config_file.empty()) file = parse_toml_file(src.config_file);
@@ -66,8 +73,8 @@ EstimateSettings resolve_settings(const SettingsSources& src, double dt_s, std::
   cfg = preset_config(*model, out.preset);
   if (dt_s > 0.0) {
     cfg.dt_s = dt_s;
-    if (out.preset == Preset::lash && !v.empty()) {
-      out.traits = analyse_record(v, y, dt_s);
+    if (out.preset == Preset::lash && record && record->size() > 0) {
+      out.traits = analyse_record(*record, dt_s);
       tune_to_data(cfg, *out.traits);
     }
   }

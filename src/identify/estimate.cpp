@@ -45,19 +45,38 @@ EstimatorConfig config_for_record(EstimatorConfig cfg, const EstimationJob& job,
 
 namespace {
 /// The result without its NRMSE: the window [t0, t1] of `job` (t1 < 0: to the last t).
-EstimateResult unscored(const EstimateReport& report, double dt_s, const EstimationJob& job,
-                        std::span<const double> t) {
+EstimateResult unscored(const EstimateReport& report, double dt_s, const EstimationJob& job, double t_last) {
   EstimateResult r;
   r.report = report;
   r.dt_s = dt_s;
   r.nrmse_t0_s = job.nrmse_t0_s;
-  r.nrmse_t1_s = job.nrmse_t1_s < 0 ? (t.empty() ? 0.0 : t.back()) : job.nrmse_t1_s;
+  r.nrmse_t1_s = job.nrmse_t1_s < 0 ? t_last : job.nrmse_t1_s;
   return r;
+}
+EstimateResult unscored(const EstimateReport& report, double dt_s, const EstimationJob& job,
+                        std::span<const double> t) {
+  return unscored(report, dt_s, job, t.empty() ? 0.0 : t.back());
 }
 /// Rows [k0, k1) of an increasing t with t0 <= t <= t1, by bisection.
 std::pair<std::size_t, std::size_t> window_rows(std::span<const double> t, double t0, double t1) {
   const auto k0 = static_cast<std::size_t>(std::lower_bound(t.begin(), t.end(), t0) - t.begin());
   const auto k1 = static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), t1) - t.begin());
+  return {k0, std::max(k0, k1)};
+}
+/// The same rows of column `c` of a store (one read per bisection step).
+std::pair<std::size_t, std::size_t> window_rows(const ColumnStore& s, std::size_t c, double t0, double t1) {
+  if (s.in_memory()) return window_rows(s.column(c), t0, t1);
+  const auto first_not = [&](auto&& below) {  // the first row whose t is not `below`
+    std::size_t lo = 0, hi = s.rows();
+    while (lo < hi) {
+      const std::size_t mid = lo + (hi - lo) / 2;
+      if (below(s.at(c, mid))) lo = mid + 1;
+      else hi = mid;
+    }
+    return lo;
+  };
+  const std::size_t k0 = first_not([&](double t) { return t < t0; });
+  const std::size_t k1 = first_not([&](double t) { return !(t1 < t); });
   return {k0, std::max(k0, k1)};
 }
 }  // namespace
@@ -88,27 +107,39 @@ ArrayEstimate estimate_arrays(const SettingsSources& src, std::span<const double
       throw InputError("", 0, name,
                        "has " + std::to_string(col.size()) + " samples, t has " + std::to_string(t.size()));
   sample_period(t);  // t: at least 3 samples, strictly increasing
+  const Sampling smp = o.sampling ? *o.sampling : analyse_sampling(t);
+  ArrayEstimateOptions o2 = o;
+  o2.sampling = &smp;
+  return estimate_record(src, RecordColumns::of(t, v, y), o2);
+}
+
+ArrayEstimate estimate_record(const SettingsSources& src, const RecordColumns& rec, const ArrayEstimateOptions& o) {
+  resolve_settings(src);  // settings are checked before the data is looked at
+  if (rec.t == RecordColumns::kNone) throw std::invalid_argument("estimate_record: the record has no t column");
+  if (!o.sampling) throw std::invalid_argument("estimate_record: the record's sampling is not given");
+  if (rec.size() < 3) throw InputError("", 0, "t", "need at least 3 samples");
   ArrayEstimate out;
-  out.sampling = o.sampling ? *o.sampling : analyse_sampling(t);
+  out.sampling = *o.sampling;
   const Sampling& smp = out.sampling;
   const auto t_start = std::chrono::steady_clock::now();
   const double cpu_start = thread_cpu_s();
-  const EstimateSettings set = resolve_settings(src, smp.dt, v, y);
+  const EstimateSettings set = resolve_settings(src, smp.dt, &rec);
   out.preset = set.preset;
   out.job = set.job;
   AutoOptions ao;
   ao.keep_trace = o.trace;
   ao.keep_outputs = o.outputs || o.trace;
+  ao.on_step = o.on_step;
   ao.gate = o.outlier_gate;
   ao.gap_rows = smp.gap_rows;
   ao.traits = set.traits ? &*set.traits : nullptr;  // the guess search needs the same quantiles
   // the NRMSE window's rows: its sum is taken during the final run (no stored y_sim needed)
-  EstimateResult scored = unscored({}, smp.dt, set.job, t);
-  std::tie(ao.score_begin, ao.score_end) = window_rows(t, scored.nrmse_t0_s, scored.nrmse_t1_s);
-  out.run = estimate_auto(set.cfg, v, y, ao);
+  EstimateResult scored = unscored({}, smp.dt, set.job, rec.store.back(rec.t));
+  std::tie(ao.score_begin, ao.score_end) = window_rows(rec.store, rec.t, scored.nrmse_t0_s, scored.nrmse_t1_s);
+  out.run = estimate_auto(set.cfg, rec, ao);
   out.estimator_cpu_s = thread_cpu_s() - cpu_start;
   out.estimator_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
-  if (o.intervals) add_intervals(out.run.run, out.run.cfg, v, y, smp.gap_rows);
+  if (o.intervals) add_intervals(out.run.run, out.run.cfg, rec, smp.gap_rows);
   scored.report = out.run.run.report;
   scored.nrmse = out.run.run.score.value();
   out.result = std::move(scored);

@@ -68,40 +68,53 @@ PerSide<SideIntervals> batch_means_intervals(const EstimatorConfig& cfg, std::sp
                                              std::span<const double> y, const PerSide<SideParams>& estimate,
                                              const IntervalSettings& s) {
   if (v.size() != y.size()) throw std::invalid_argument("v and y differ in length");
-  const std::size_t n = v.size(), B = s.sections;
+  return batch_means_intervals(cfg, RecordColumns::of(v, y), estimate, s);
+}
+
+PerSide<SideIntervals> batch_means_intervals(const EstimatorConfig& cfg, const RecordColumns& rec,
+                                             const PerSide<SideParams>& estimate, const IntervalSettings& s) {
+  const std::size_t n = rec.size(), B = s.sections;
   if (B < 2 || n / B < 2) return {};
   const std::size_t len = n / B;
   // Each section's estimator starts fresh. Sections b and b + half run in lockstep in one loop:
   // two independent recursions (each RLS update waits on its own last result) that the CPU
   // overlaps, where one after the other they left it waiting. Same samples, same order per
-  // estimator: the same bits as one section after the other.
+  // estimator: the same bits as one section after the other. Both sections are read in chunks of
+  // the same rows within the section (a spilled record streams; in memory: one chunk, views).
   const std::size_t half = (B + 1) / 2;
   std::vector<PerSide<SideParams>> at(B);
   AnyEstimator ea(cfg), eb(cfg);
+  ChunkBuffer<2> bx, bz;
   for (std::size_t b = 0; b < half; ++b) {
     ea.reset();
     eb.reset();
     const std::size_t b2 = b + half, a0 = b * len, c0 = b2 * len;
     if (b2 >= B) {
-      step_through(ea, v, y, a0, a0 + len, s.gap_rows, [](std::size_t, const auto&) {});
+      step_through(ea, rec, a0, a0 + len, s.gap_rows, [](std::size_t, double, const auto&) {});
     } else {
       ea.visit_steps(len, [&](auto& x) {
         eb.visit_steps(len, [&](auto& z) {
           if constexpr (std::is_same_v<decltype(x), decltype(z)>) {
             const auto& g = s.gap_rows;
             auto gx = std::lower_bound(g.begin(), g.end(), a0), gz = std::lower_bound(g.begin(), g.end(), c0);
-            for (std::size_t i = 0; i < len; ++i) {
-              const std::size_t kx = a0 + i, kz = c0 + i;
-              if (gx != g.end() && *gx == kx) {
-                if (i > 0) x.restart();  // at the section's start the history is already empty
-                ++gx;
+            const std::size_t chunk = rec.store.in_memory() ? len : ColumnStore::kChunkRows;
+            for (std::size_t i0 = 0; i0 < len; i0 += chunk) {
+              const std::size_t m = std::min(chunk, len - i0);
+              const auto cx = bx.get(rec.store, rec.vy, a0 + i0, m), cz = bz.get(rec.store, rec.vy, c0 + i0, m);
+              const std::span<const double> vx = cx[0], yx = cx[1], vz = cz[0], yz = cz[1];
+              for (std::size_t j = 0; j < m; ++j) {
+                const std::size_t i = i0 + j, kx = a0 + i, kz = c0 + i;
+                if (gx != g.end() && *gx == kx) {
+                  if (i > 0) x.restart();  // at the section's start the history is already empty
+                  ++gx;
+                }
+                if (gz != g.end() && *gz == kz) {
+                  if (i > 0) z.restart();
+                  ++gz;
+                }
+                x.step(vx[j], yx[j]);
+                z.step(vz[j], yz[j]);
               }
-              if (gz != g.end() && *gz == kz) {
-                if (i > 0) z.restart();
-                ++gz;
-              }
-              x.step(v[kx], y[kx]);
-              z.step(v[kz], y[kz]);
             }
           } else {
             (void)x;  // one config, one model: never two kinds

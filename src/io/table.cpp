@@ -28,6 +28,12 @@ std::string header_list(const std::vector<std::string>& names) {
 }
 }  // namespace
 
+ColumnStore Table::store() const {
+  if (spilled.rows()) return spilled;
+  std::vector<std::span<const double>> v(cols.begin(), cols.end());
+  return ColumnStore(std::move(v));
+}
+
 std::size_t Table::column(std::string_view name) const {
   for (std::size_t i = 0; i < names.size(); ++i)
     if (names[i] == name) return i;
@@ -195,6 +201,7 @@ class TextReader {
       std::memmove(buf.data(), p, have);
     }
     if (!have_header_) throw InputError(t_.file, 0, "", "empty file (expected a header line and data rows)");
+    if (spill_) t_.spilled = spill_->finish();
     if (t_.rows() == 0)
       throw InputError(t_.file, lineno_, "",
                        t_.skipped_rows ? "no data rows with finite values (" + std::to_string(t_.skipped_rows) +
@@ -250,7 +257,8 @@ class TextReader {
     vals_.resize(idx.size());
     // Reserve from the file size and the first block's line density: one allocation per column.
     const double per_line = static_cast<double>(bytes_first_block_) / static_cast<double>(std::max<std::size_t>(1, lines_first_block_));
-    const auto rows_est = static_cast<std::size_t>(static_cast<double>(file_size_) / std::max(1.0, per_line) * 1.05) + 16;
+    auto rows_est = static_cast<std::size_t>(static_cast<double>(file_size_) / std::max(1.0, per_line) * 1.05) + 16;
+    if (o_.spill_after_rows) rows_est = std::min(rows_est, o_.spill_after_rows);  // the rest goes to the spill file
     for (auto& c : t_.cols) c.reserve(rows_est);
     if (numeric) row(sv.data(), sv.data() + sv.size());
   }
@@ -310,9 +318,21 @@ class TextReader {
       if (t_.skipped_rows++ == 0) t_.first_skipped_line = lineno_;
       return;
     }
+    t_.line_of_row.push_back(lineno_);
+    if (spill_) {
+      spill_->push(vals_.data());
+      return;
+    }
+    if (o_.spill_after_rows && t_.cols[0].size() == o_.spill_after_rows) [[unlikely]] {
+      // long: the rows so far and every later one go to a temporary file; the columns are freed
+      spill_ = std::make_unique<SpillWriter>(vals_.size());
+      spill_->push_columns(t_.cols, t_.cols[0].size());
+      for (auto& c : t_.cols) std::vector<double>().swap(c);
+      spill_->push(vals_.data());
+      return;
+    }
     if (t_.cols[0].size() == t_.cols[0].capacity()) [[unlikely]] grow();
     for (std::size_t s = 0; s < vals_.size(); ++s) t_.cols[s].push_back(vals_[s]);
-    t_.line_of_row.push_back(lineno_);
   }
 
   /// The reservation from the first block was short (later lines are shorter): reserve for the
@@ -343,6 +363,7 @@ class TextReader {
   std::size_t nfields_ = 0, last_field_ = 0;
   std::vector<int> slot_of_field_;
   std::vector<double> vals_;
+  std::unique_ptr<SpillWriter> spill_;  ///< past spill_after_rows: where the rows go
   std::uintmax_t file_size_ = 0;
   std::uint64_t consumed_ = 0;  ///< bytes of the file before the current block's first line
   std::size_t bytes_first_block_ = 0, lines_first_block_ = 0;
@@ -486,6 +507,13 @@ Sampling analyse_sampling(std::span<const double> t, double gap_factor) {
   const std::size_t n = t.size() - 1 - s.gap_rows.size();
   s.dt = n ? (t.back() - t.front() - gap_sum) / static_cast<double>(n) : med;
   return s;
+}
+
+Sampling analyse_sampling(const ColumnStore& store, std::size_t column, double gap_factor) {
+  if (store.in_memory()) return analyse_sampling(store.column(column), gap_factor);
+  std::vector<double> t(store.rows());  // TODO(bounded): chunked median
+  store.read(column, 0, t.size(), t.data());
+  return analyse_sampling(t, gap_factor);
 }
 
 }  // namespace lash

@@ -3,6 +3,7 @@
 /// One type for every estimator of docs/method.md §A4 (a std::variant, no virtual calls), plus a
 /// summary report and a batch runner used by `lash estimate`, `lash demo` and sweeps.
 #include <algorithm>
+#include <array>
 #include <functional>
 #include <cstdint>
 #include <span>
@@ -13,6 +14,7 @@
 
 #include "lash/identify/estimators.hpp"
 #include "lash/identify/intervals.hpp"
+#include "lash/identify/record_columns.hpp"
 #include "lash/metrics/fit.hpp"  // nrmse, outside_3sigma_per_1000 (were declared here)
 
 namespace lash {
@@ -141,40 +143,56 @@ struct YEdits {
   std::span<const double> values;
 };
 
-/// Steps `est` through samples [begin, end) of v, y, calling restart() before every row listed
-/// in `gap_rows` (ascending row indices where a gap ends, as Record::gap_rows() / Table::gap_rows;
-/// a gap row outside the range is ignored), and `each(k, e)` after the step of sample k, where `e`
-/// is the concrete estimator (LinearEstimator, ...): the variant is dispatched once per call, not
-/// per sample. `edits`: samples of y read from elsewhere (YEdits). The one run loop of every
+/// Steps the concrete estimator `e` through rows [begin, end) of a chunk whose v[0], y[0] are row
+/// `base`, restarting it before every row of `gap_rows` after row `first` (where its run started:
+/// the history is empty there), reading y from `edits` at an edited row, and calling
+/// each(k, y_k as given, e) after the step of row k.
+template <class E, class Each>
+void step_rows(E& e, std::span<const double> v, std::span<const double> y, std::size_t base, std::size_t begin,
+               std::size_t end, std::size_t first, std::span<const std::size_t> gap_rows, YEdits edits,
+               Each& each) {
+  constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+  auto gap = std::lower_bound(gap_rows.begin(), gap_rows.end(), begin);
+  auto edit = std::lower_bound(edits.rows.begin(), edits.rows.end(), begin);
+  std::size_t next_gap = gap != gap_rows.end() ? *gap : kNone;
+  std::size_t next_edit = edit != edits.rows.end() ? *edit : kNone;
+  std::size_t next = std::min(next_gap, next_edit);  // one comparison per sample for both
+  for (std::size_t k = begin, i = begin - base; k < end; ++k, ++i) {  // i: k's index in the chunk
+    const double yg = y[i];
+    double yk = yg;
+    if (k == next) [[unlikely]] {
+      if (k == next_gap) {
+        if (k > first) e.restart();  // at `first` the history is already empty (new or reset estimator)
+        ++gap;
+        next_gap = gap != gap_rows.end() ? *gap : kNone;
+      }
+      if (k == next_edit) {
+        yk = edits.values[static_cast<std::size_t>(edit - edits.rows.begin())];
+        ++edit;
+        next_edit = edit != edits.rows.end() ? *edit : kNone;
+      }
+      next = std::min(next_gap, next_edit);
+    }
+    e.step(v[i], yk);
+    each(k, yg, std::as_const(e));
+  }
+}
+
+/// Steps `est` through samples [begin, end) of the record `r`, calling restart() before every row
+/// listed in `gap_rows` (ascending row indices where a gap ends, as Record::gap_rows() /
+/// Table::gap_rows; a gap row outside the range is ignored), and `each(k, y_k, e)` after the step
+/// of sample k, where y_k is y[k] as given (not edited) and `e` the concrete estimator
+/// (LinearEstimator, ...): the variant is dispatched once per call, not per sample. `edits`:
+/// samples of y read from elsewhere (YEdits). The record is read in chunks (for_chunks): the same
+/// samples in the same order, the same bits as over arrays. The one run loop of every
 /// whole-record estimation (run_estimator, search_guesses, the intervals' sections).
 template <class Each>
-void step_through(AnyEstimator& est, std::span<const double> v, std::span<const double> y, std::size_t begin,
-                  std::size_t end, std::span<const std::size_t> gap_rows, Each&& each, YEdits edits = {}) {
+void step_through(AnyEstimator& est, const RecordColumns& r, std::size_t begin, std::size_t end,
+                  std::span<const std::size_t> gap_rows, Each&& each, YEdits edits = {}) {
   est.visit_steps(end - begin, [&](auto& e) {
-    constexpr std::size_t kNone = static_cast<std::size_t>(-1);
-    auto gap = std::lower_bound(gap_rows.begin(), gap_rows.end(), begin);
-    auto edit = std::lower_bound(edits.rows.begin(), edits.rows.end(), begin);
-    std::size_t next_gap = gap != gap_rows.end() ? *gap : kNone;
-    std::size_t next_edit = edit != edits.rows.end() ? *edit : kNone;
-    std::size_t next = std::min(next_gap, next_edit);  // one comparison per sample for both
-    for (std::size_t k = begin; k < end; ++k) {
-      double yk = y[k];
-      if (k == next) [[unlikely]] {
-        if (k == next_gap) {
-          if (k > begin) e.restart();  // at `begin` the history is already empty (new or reset estimator)
-          ++gap;
-          next_gap = gap != gap_rows.end() ? *gap : kNone;
-        }
-        if (k == next_edit) {
-          yk = edits.values[static_cast<std::size_t>(edit - edits.rows.begin())];
-          ++edit;
-          next_edit = edit != edits.rows.end() ? *edit : kNone;
-        }
-        next = std::min(next_gap, next_edit);
-      }
-      e.step(v[k], yk);
-      each(k, std::as_const(e));
-    }
+    for_chunks(r.store, r.vy, begin, end, [&](std::size_t base, const auto& c) {
+      step_rows(e, c[0], c[1], base, base, base + c[0].size(), begin, gap_rows, edits, each);
+    });
   });
 }
 
@@ -189,8 +207,19 @@ struct EstimationRun {
   NrmseAccumulator score;
 };
 
+/// One step of a run as a trace sink sees it (RunOptions::on_step).
+struct TraceRow {
+  std::size_t k = 0;               ///< row
+  double y = 0.0;                  ///< y[k] as given (before any YEdits)
+  double yhat = 0.0, ysim = 0.0;   ///< one-step prediction and free-run simulation
+  std::span<const double> params;  ///< every parameter in param_names() order (NaN: not identified)
+};
+
 struct RunOptions {
   bool keep_trace = false;    ///< store every parameter per step (EstimationRun::params)
+  /// Called after every step (the trace streamed to a file as the run goes: nothing per sample is
+  /// kept in memory). Not called when empty.
+  std::function<void(const TraceRow&)> on_step;
   bool keep_outputs = true;   ///< store ŷ and y_sim per step (EstimationRun::yhat, ysim)
   /// `at_end`, when given, is called with the estimator after the last sample (to read more of
   /// its final state without a second pass over the record).
@@ -200,7 +229,9 @@ struct RunOptions {
   std::size_t score_begin = 0, score_end = 0;  ///< rows [begin, end) of EstimationRun::score
 };
 
-/// Steps `cfg`'s estimator through v, y (same length), as RunOptions say. Not real-time safe.
+/// Steps `cfg`'s estimator through the record, as RunOptions say. Not real-time safe.
+EstimationRun run_estimator(const EstimatorConfig& cfg, const RecordColumns& record, const RunOptions& options);
+/// The same over v, y (same length).
 EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> v, std::span<const double> y,
                             const RunOptions& options);
 /// Steps `cfg`'s estimator through v, y (same length). keep_trace stores the parameters per step.
@@ -213,6 +244,8 @@ EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> 
                             std::span<const std::size_t> gap_rows = {});
 /// Adds the 95 % intervals of every identified side's parameters to run.report (batch means,
 /// intervals.hpp: runs the estimator once more over sections of the same record).
+void add_intervals(EstimationRun& run, const EstimatorConfig& cfg, const RecordColumns& record,
+                   std::span<const std::size_t> gap_rows = {});
 void add_intervals(EstimationRun& run, const EstimatorConfig& cfg, std::span<const double> v,
                    std::span<const double> y, std::span<const std::size_t> gap_rows = {});
 /// Sets the 95 % intervals ci on the identified sides of rep and applies verdict check 7

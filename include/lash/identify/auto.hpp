@@ -11,6 +11,8 @@
 /// Not real-time safe (allocates, runs whole records). The sample path stays in the estimators.
 #include <array>
 #include <cstdint>
+#include <functional>
+#include <vector>
 #include <span>
 #include <string>
 #include <string_view>
@@ -53,6 +55,8 @@ struct DataTraits {
 /// Not real-time safe. Non-finite samples are ignored. `y_edits`: samples of y read from
 /// elsewhere (the outlier gate's replacements, any_estimator.hpp YEdits).
 DataTraits analyse_record(std::span<const double> v, std::span<const double> y, double dt_s, YEdits y_edits = {});
+/// The same over a record's columns, read in chunks (a spilled record streams).
+DataTraits analyse_record(const RecordColumns& record, double dt_s, YEdits y_edits = {});
 
 /// Sets the data-dependent settings of a `Preset::lash` config (docs/identification.md).
 void tune_to_data(EstimatorConfig& cfg, const DataTraits& d);
@@ -81,6 +85,8 @@ struct AutoRun {
 struct AutoOptions {
   bool keep_trace = false;    ///< every parameter per step (RunOptions::keep_trace)
   bool keep_outputs = true;   ///< ŷ and y_sim per step (RunOptions::keep_outputs)
+  /// The final run's trace, streamed (RunOptions::on_step).
+  std::function<void(const TraceRow&)> on_step;
   double gate = 12.0;         ///< the outlier gate's threshold [innovation scales] (0 = off)
   std::span<const std::size_t> gap_rows;  ///< where t jumps (Record::gap_rows())
   /// Rows [begin, end) whose NRMSE of the final run's y_sim against y (as given, not gated) is
@@ -102,6 +108,8 @@ struct AutoOptions {
 /// estimator's regressors at `options.gap_rows` (AnyEstimator::restart).
 AutoRun estimate_auto(const EstimatorConfig& cfg, std::span<const double> v, std::span<const double> y,
                       const AutoOptions& options);
+/// The same over a record's columns, read in chunks (a spilled record streams).
+AutoRun estimate_auto(const EstimatorConfig& cfg, const RecordColumns& record, const AutoOptions& options);
 /// The same with the options of before: keep_trace, gate, gap_rows (outputs kept, no score).
 AutoRun estimate_auto(const EstimatorConfig& cfg, std::span<const double> v, std::span<const double> y,
                       bool keep_trace = false, double gate = 12.0, std::span<const std::size_t> gap_rows = {});
@@ -112,6 +120,9 @@ AutoRun estimate_auto(const EstimatorConfig& cfg, std::span<const double> v, std
 /// replaced rows (ascending) and their values to `rows` and `values` (YEdits' parts).
 void gate_outliers(std::span<const double> y, double gate, std::vector<std::size_t>& rows,
                    std::vector<double>& values);
+/// The same over the y column of a record, read in chunks.
+void gate_outliers(const RecordColumns& record, double gate, std::vector<std::size_t>& rows,
+                   std::vector<double>& values);
 
 /// The switching guesses estimate_auto would use on this record ({c_r*, c_l*}); for the sweep,
 /// which runs its estimator online on a rig whose open-loop record it can take first.
@@ -120,5 +131,9 @@ void gate_outliers(std::span<const double> y, double gate, std::vector<std::size
 std::array<double, 2> search_guesses(const EstimatorConfig& cfg, std::span<const double> v,
                                      std::span<const double> y, std::span<const std::size_t> gap_rows = {},
                                      YEdits y_edits = {}, const DataTraits* traits = nullptr);
+/// The same over a record's columns, read in chunks.
+std::array<double, 2> search_guesses(const EstimatorConfig& cfg, const RecordColumns& record,
+                                     std::span<const std::size_t> gap_rows = {}, YEdits y_edits = {},
+                                     const DataTraits* traits = nullptr);
 
 }  // namespace lash

@@ -42,5 +42,7 @@ struct EstimateSettings {
 /// the settings are only checked); v, y: the record (empty: nothing is chosen from data).
 EstimateSettings resolve_settings(const SettingsSources& src, double dt_s = 0.0, std::span<const double> v = {},
                                   std::span<const double> y = {});
+/// The same with the record's columns (nullptr or empty: nothing is chosen from data).
+EstimateSettings resolve_settings(const SettingsSources& src, double dt_s, const RecordColumns* record);
 
 }  // namespace lash

@@ -5,6 +5,7 @@
 /// estimate_json() of estimate_report.hpp. One implementation, so the CLI's `--json` and
 /// Python's `Result.to_dict()` cannot drift apart.
 /// Not real-time safe (allocates). Errors are lash::InputError naming file, line and column.
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
@@ -57,6 +58,8 @@ struct ArrayEstimateOptions {
   bool intervals = true;       ///< the 95 % intervals (add_intervals: one more estimator pass over sections)
   /// The sampling of t when the caller has it already (a file's reader analysed it): else analysed here.
   const Sampling* sampling = nullptr;
+  /// Called after every step of the final run (the trace streamed: RunOptions::on_step).
+  std::function<void(const TraceRow&)> on_step;
   std::size_t rows_skipped = 0;  ///< rows the reader dropped for a non-finite value (reported, not used)
   int first_skipped_line = 0;    ///< file line of the first of them
 };
@@ -85,5 +88,12 @@ struct ArrayEstimate {
 /// t [s], v, y: equal lengths (else InputError naming v or y). Not real-time safe.
 ArrayEstimate estimate_arrays(const SettingsSources& src, std::span<const double> t, std::span<const double> v,
                               std::span<const double> y, const ArrayEstimateOptions& options = {});
+
+/// The same over a record's columns t, v, y (RecordColumns with its t column), read in chunks: a
+/// record spilled to a temporary file (load_record on a long file) is estimated in memory that
+/// does not grow with it. t must be known to increase strictly (load_record checked it) and
+/// `options.sampling` given (load_record analysed it); std::invalid_argument otherwise.
+ArrayEstimate estimate_record(const SettingsSources& src, const RecordColumns& record,
+                              const ArrayEstimateOptions& options);
 
 }  // namespace lash

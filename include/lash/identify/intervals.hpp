@@ -20,6 +20,7 @@
 
 #include "lash/blocks/side.hpp"
 #include "lash/identify/config.hpp"
+#include "lash/identify/record_columns.hpp"
 #include "lash/identify/verdict.hpp"
 
 namespace lash {
@@ -46,6 +47,9 @@ struct IntervalSettings {
 PerSide<SideIntervals> batch_means_intervals(const EstimatorConfig& cfg, std::span<const double> v,
                                              std::span<const double> y, const PerSide<SideParams>& estimate,
                                              const IntervalSettings& s = {});
+/// The same over a record's columns (read in chunks: a spilled record streams).
+PerSide<SideIntervals> batch_means_intervals(const EstimatorConfig& cfg, const RecordColumns& record,
+                                             const PerSide<SideParams>& estimate, const IntervalSettings& s = {});
 
 /// The same intervals from section estimates already at hand (each section's per-side
 /// parameters, identified or not, in order; the monitor's online sections, docs/monitor.md):

@@ -28,6 +28,8 @@
 #include <span>
 #include <vector>
 
+#include "lash/io/column_store.hpp"
+
 namespace lash {
 
 /// The file line of each row of a table, kept as runs of rows on consecutive lines (a file
@@ -85,8 +87,13 @@ struct Table {
   std::size_t skipped_rows = 0;           ///< rows dropped for a non-finite chosen cell
   int first_skipped_line = 0;             ///< line of the first such row (0: none)
   std::vector<std::size_t> gap_rows;      ///< rows i where a gap ends (mark_gaps): t[i] − t[i−1] is a gap
+  /// A text file longer than TableOptions::spill_after_rows: every row is here, in a temporary
+  /// file (io/column_store.hpp), and `cols` is empty.
+  ColumnStore spilled;
 
-  std::size_t rows() const noexcept { return cols.empty() ? 0 : cols[0].size(); }
+  std::size_t rows() const noexcept { return spilled.rows() ? spilled.rows() : cols.empty() ? 0 : cols[0].size(); }
+  /// The columns as a store: views of `cols`, or the spill file.
+  ColumnStore store() const;
   /// Index of column `name`, or throws InputError naming the file, header line and column.
   std::size_t column(std::string_view name) const;
   const std::vector<double>& operator[](std::string_view name) const { return cols[column(name)]; }
@@ -97,6 +104,9 @@ struct TableOptions {
   /// MAT: variable names or expressions (io/mat.hpp), or indices into a file's only N×k matrix.
   std::vector<std::string> columns;
   bool strict = false;  ///< a non-finite chosen cell is an error instead of a skipped row
+  /// Text files: beyond this many rows the table goes to a temporary file (Table::spilled) instead
+  /// of memory (0: never). MAT files are read into memory whole.
+  std::size_t spill_after_rows = 0;
 };
 
 /// Reads a record (MAT or text, see above). Throws InputError naming file, line and column.
@@ -138,5 +148,7 @@ struct Sampling {
 };
 /// Sampling of `t` (at least 2 samples). Steps above gap_factor·median are gaps.
 Sampling analyse_sampling(std::span<const double> t, double gap_factor = kGapFactor);
+/// The same of column `column` of a store (read in chunks when it is spilled).
+Sampling analyse_sampling(const ColumnStore& store, std::size_t column, double gap_factor = kGapFactor);
 
 }  // namespace lash
