@@ -49,7 +49,7 @@ std::map<std::string, std::pair<double, double>> ci95_columns(const EstimateRepo
 /// Rows of a record `lash estimate` holds in memory; a longer record is read into a temporary
 /// file and estimated from there in chunks (docs/memory.md). LASH_SPILL_ROWS overrides it.
 std::size_t spill_after_rows() {
-  constexpr std::size_t kDefault = std::size_t{1} << 20;  // 24 MiB of t, v, y
+  constexpr std::size_t kDefault = std::size_t{1} << 16;  // 1.5 MiB of t, v, y
   const char* env = std::getenv("LASH_SPILL_ROWS");
   if (!env || !*env) return kDefault;
   char* end = nullptr;

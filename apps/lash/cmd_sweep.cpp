@@ -12,7 +12,6 @@
 #include "cli_common.hpp"
 #include "csv_stream.hpp"
 #include "lash/io/atomic_file.hpp"
-#include "lash/io/memory.hpp"
 #include "plot.hpp"
 #include "lash/experiments/campaign.hpp"
 #include "lash/experiments/sweep.hpp"
@@ -136,14 +135,6 @@ int run(const SweepOptions& o) {
   check_output_path(o.out, "--output");
   if (!o.plot.empty()) check_output_path(o.plot, "--plot");
   if (!o.trace.empty()) check_output_path(o.trace[1], "--trace");
-  try {
-    require_memory(sweep::campaign_memory_bytes(c, o.jobs),
-                   fmt::format("the settings analysis of {} (no [estimator] table: each worker keeps its run's "
-                               "record, ~60 bytes a sample)",
-                               o.campaign));
-  } catch (const std::invalid_argument& e) {
-    throw InputError(o.campaign, 0, "--jobs", e.what());
-  }
   if (!o.trace.empty()) {
     write_trace(c, o.trace);
     if (!o.quiet) fmt::print(stderr, "trace of run {} -> {}\n", o.trace[0], o.trace[1]);

@@ -127,11 +127,16 @@ RunResult run_deadzone_model(const Campaign& c, const EstimatorConfig& ec, const
   return finish(c, r, est, score);
 }
 
+/// Rows of a run's record kept in memory for the settings analysis; a longer record goes to a
+/// temporary file (io/column_store.hpp), so that a worker's memory does not grow with its run.
+constexpr std::size_t kRecordInMemory = std::size_t{1} << 16;
+
 /// The rig's open-loop record of run r (v(k), the y the estimator would see): the rig does not
-/// depend on the estimator, so the settings can be taken from it before the run itself.
+/// depend on the estimator, so the settings can be taken from it before the run itself. In
+/// `v`, `y` (short runs) or a spill file (long ones); returns the record's columns.
 template <class Rig, class Measure>
-void record_run(const Campaign& c, const RunSpec& r, Measure measure, std::vector<double>& v,
-                std::vector<double>& y) {
+RecordColumns record_run(const Campaign& c, const RunSpec& r, Measure measure, std::vector<double>& v,
+                         std::vector<double>& y) {
   Signal sig(signal_of(c, r), c.dt_s);
   const std::size_t n = sample_count(c.duration_s, c.dt_s);
   Rig rig = [&] {
@@ -140,13 +145,25 @@ void record_run(const Campaign& c, const RunSpec& r, Measure measure, std::vecto
     else return Rig(c.rig.coupled_carts, c.dt_s, r.seed);
   }();
   auto out = rig.initial_output();
-  v.resize(n);
-  y.resize(n);
-  for (std::size_t k = 0; k < n; ++k) {
-    v[k] = sig.next();
-    y[k] = measure(out).first;
-    out = rig.step(v[k]);
+  if (n <= kRecordInMemory) {
+    v.resize(n);
+    y.resize(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      v[k] = sig.next();
+      y[k] = measure(out).first;
+      out = rig.step(v[k]);
+    }
+    return RecordColumns::of(v, y);
   }
+  SpillWriter w(2);
+  for (std::size_t k = 0; k < n; ++k) {
+    const double row[2] = {sig.next(), measure(out).first};
+    w.push(row);
+    out = rig.step(row[0]);
+  }
+  RecordColumns rec;
+  rec.store = w.finish();
+  return rec;
 }
 
 /// Settings of run r: the campaign's, or (no [estimator] table) lash's tuned to the run's record.
@@ -155,15 +172,16 @@ EstimatorConfig settings_for(const Campaign& c, const RunSpec& r) {
   std::vector<double> v, y;
   auto same = [](double x) { return std::pair<double, double>{x, x}; };
   auto pos = [](const rigs::CoupledCartsSample& s) { return std::pair<double, double>{s.position_m, s.velocity_m_s}; };
+  RecordColumns rec;
   switch (c.rig.kind) {
-    case rigs::RigKind::motor_cart: record_run<rigs::MotorCart>(c, r, same, v, y); break;
-    case rigs::RigKind::pilot_valve: record_run<rigs::PilotValveRig>(c, r, same, v, y); break;
-    case rigs::RigKind::coupled_carts: record_run<rigs::CoupledCarts>(c, r, pos, v, y); break;
+    case rigs::RigKind::motor_cart: rec = record_run<rigs::MotorCart>(c, r, same, v, y); break;
+    case rigs::RigKind::pilot_valve: rec = record_run<rigs::PilotValveRig>(c, r, same, v, y); break;
+    case rigs::RigKind::coupled_carts: rec = record_run<rigs::CoupledCarts>(c, r, pos, v, y); break;
   }
   EstimatorConfig e = c.estimator;
-  tune_to_data(e, analyse_record(v, y, c.dt_s));
+  tune_to_data(e, analyse_record(rec, c.dt_s));
   if (std::isinf(e.guess_left) || std::isinf(e.guess_right)) {
-    const auto g = search_guesses(e, v, y);
+    const auto g = search_guesses(e, rec);
     if (std::isinf(e.guess_right)) e.guess_right = g[0];
     if (std::isinf(e.guess_left)) e.guess_left = g[1];
   }
@@ -221,13 +239,6 @@ RunResult run_one(const Campaign& c, const RunSpec& r, const TraceFn& trace) {
     }
   }
   return out;
-}
-
-double campaign_memory_bytes(const Campaign& c, unsigned jobs) {
-  if (!c.estimator_from_data) return 0.0;
-  if (jobs == 0) jobs = std::max(1u, std::thread::hardware_concurrency());
-  const double workers = static_cast<double>(std::min<std::size_t>(jobs, std::max<std::size_t>(c.runs.size(), 1)));
-  return 60.0 * std::round(c.duration_s / c.dt_s) * workers;
 }
 
 std::vector<RunResult> run_campaign(const Campaign& c, unsigned jobs, const ProgressFn& progress) {

@@ -65,12 +65,6 @@ using TraceFn = std::function<void(const TraceRow&)>;
 /// first (v and y of the run, 16 bytes a sample, freed before the run).
 RunResult run_one(const Campaign& c, const RunSpec& run, const TraceFn& trace = {});
 
-/// Memory that grows with a run's length, for `jobs` workers (0 = all cores), at least: a
-/// campaign without an [estimator] table keeps each worker's run record for the settings
-/// analysis, ~60 bytes a sample (16 of v and y, the rest identify's analysis; measured,
-/// docs/memory.md); 0 otherwise (the runs are O(1)).
-double campaign_memory_bytes(const Campaign& c, unsigned jobs);
-
 /// Called from the coordinating thread with (runs done, total) about five times a second
 /// and once at the end.
 using ProgressFn = std::function<void(std::size_t done, std::size_t total)>;
