@@ -26,6 +26,7 @@ struct Command {
 
 /// Each subcommand file defines one of these.
 Command add_simulate(CLI::App& app);
+Command add_excite(CLI::App& app);
 Command add_demo(CLI::App& app);
 Command add_closed_loop(CLI::App& app);
 /// lash closed-loop --scenario (cmd_closed_loop_scenario.cpp).

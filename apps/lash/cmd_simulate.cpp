@@ -11,6 +11,7 @@
 #include "plot.hpp"
 #include "lash/plant/plant_file.hpp"
 #include "lash/plant/simulate.hpp"
+#include "lash/io/table.hpp"
 
 namespace lash::cli {
 namespace {
@@ -25,7 +26,9 @@ struct SimulateOptions {
   double variance = 10000.0;
   double tau = 0.5;
   std::string steps;
+  std::string input_file;       // t,v CSV (e.g. from lash excite): v sample by sample
   double duration = 10.0;
+  bool duration_given = false;
   std::optional<double> dt;
   double noise_variance = 0.0;
   std::uint64_t seed = 1;
@@ -73,12 +76,13 @@ void check_options(const SimulateOptions& o, const SimulationSpec& spec, const P
   }
   if (!(std::isfinite(o.noise_variance) && o.noise_variance >= 0))
     throw InputError("", 0, "--noise-variance", fmt::format("must be a finite number >= 0 [y unit^2], got {}", o.noise_variance));
-  if (!(std::isfinite(o.duration) && o.duration > 0))
-    throw InputError("", 0, "--duration", fmt::format("must be a finite number > 0 [s], got {}", o.duration));
+  const double duration = spec.duration_s;
+  if (!(std::isfinite(duration) && duration > 0))
+    throw InputError("", 0, "--duration", fmt::format("must be a finite number > 0 [s], got {}", duration));
   try {
-    n = sample_count(o.duration, plant.dt_s());
+    n = sample_count(duration, plant.dt_s());
   } catch (const std::invalid_argument& e) {
-    throw InputError("", 0, "--duration", fmt::format("{} s at dt = {} s: {} (at most 1e9 samples)", format_double(o.duration),
+    throw InputError("", 0, "--duration", fmt::format("{} s at dt = {} s: {} (at most 1e9 samples)", format_double(duration),
                                                       format_double(plant.dt_s()), e.what()));
   }
   // The plant's worst case over n samples (plant/simulate.hpp): the input must keep it below 1e300.
@@ -99,7 +103,7 @@ void check_options(const SimulateOptions& o, const SimulationSpec& spec, const P
                                                     g6(limit), why, g6(o.offset)));
   switch (spec.input.kind) {
     case Waveform::steps:
-      throw InputError("", 0, "--steps", fmt::format("every |VALUE| + |offset| must be at most {} [input unit]: {}",
+      throw InputError("", 0, o.input_file.empty() ? "--steps" : "--input-file", fmt::format("every |VALUE| + |offset| must be at most {} [input unit]: {}",
                                                      g6(limit), why));
     case Waveform::randomized: {
       const double s = (limit - off) / 12.1;
@@ -120,18 +124,36 @@ int run(const SimulateOptions& o) {
   if (!o.plot.empty()) check_output_path(o.plot, "--plot");
   Plant plant = load_plant(o.plant, o.dt.value_or(0.0));
   SimulationSpec spec;
-  try {
-    spec.input.kind = parse_waveform(o.input);
-  } catch (const std::invalid_argument& e) {
-    throw InputError("", 0, "--input", e.what());
+  double duration = o.duration;
+  if (!o.input_file.empty()) {
+    // the file's v, one sample per plant step: its t must step by the plant's dt
+    TableOptions to;
+    to.columns = {"t", "v"};
+    to.strict = true;
+    const Table tab = read_table(o.input_file, to);
+    const auto& t = tab.cols[0];
+    if (t.size() < 2) throw InputError(o.input_file, 0, "--input-file", "needs at least 2 rows of t,v");
+    const double step = (t.back() - t.front()) / static_cast<double>(t.size() - 1);
+    if (!(std::fabs(step - plant.dt_s()) <= 1e-6 * plant.dt_s()))
+      throw InputError(o.input_file, 0, "--input-file",
+                       fmt::format("t steps by {} s, the plant's dt is {} s (give --dt {})", format_double(step),
+                                   format_double(plant.dt_s()), format_double(step)));
+    spec.input = sampled_signal(tab.cols[1], plant.dt_s());
+    if (!o.duration_given) duration = static_cast<double>(t.size()) * plant.dt_s();
+  } else {
+    try {
+      spec.input.kind = parse_waveform(o.input);
+    } catch (const std::invalid_argument& e) {
+      throw InputError("", 0, "--input", e.what());
+    }
+    spec.input.amplitude = o.amplitude;
+    spec.input.frequency_rad_s = o.frequency;
+    spec.input.offset = o.offset;
+    spec.input.phase_rad = o.phase;
+    spec.input.variance = o.variance;
+    spec.input.tau_s = o.tau;
   }
-  spec.input.amplitude = o.amplitude;
-  spec.input.frequency_rad_s = o.frequency;
-  spec.input.offset = o.offset;
-  spec.input.phase_rad = o.phase;
-  spec.input.variance = o.variance;
-  spec.input.tau_s = o.tau;
-  if (spec.input.kind == Waveform::steps) {
+  if (spec.input.kind == Waveform::steps && o.input_file.empty()) {
     if (o.steps.empty()) throw InputError("", 0, "--steps", "the steps input needs --steps TIME:VALUE,…");
     spec.input.steps = parse_steps(o.steps);
     try {
@@ -140,7 +162,7 @@ int run(const SimulateOptions& o) {
       throw InputError("", 0, "--steps", e.what());
     }
   }
-  spec.duration_s = o.duration;
+  spec.duration_s = duration;
   spec.noise_variance = o.noise_variance;
   spec.seed = o.seed;
   std::size_t n = 0;
@@ -173,13 +195,20 @@ Command add_simulate(CLI::App& app) {
   sub->add_option("--variance", o->variance, "randomized: variance of the Gaussian drawn each step");
   sub->add_option("--tau", o->tau, "randomized: low-pass time constant [s]");
   sub->add_option("--steps", o->steps, "steps: TIME:VALUE,TIME:VALUE,... [s]:[input unit]");
-  sub->add_option("--duration", o->duration, "Duration [s]; N = round(duration/dt) samples");
+  sub->add_option("--input-file", o->input_file,
+                  "t,v CSV (e.g. from lash excite): the input sample by sample, t stepping by the plant's dt; "
+                  "replaces --input; after its last row v holds its last value");
+  sub->add_option("--duration", o->duration,
+                  "Duration [s]; N = round(duration/dt) samples (with --input-file: default its length)");
   sub->add_option("--dt", o->dt, "Sample period [s], overrides the plant file's dt");
   sub->add_option("--noise-variance", o->noise_variance, "Variance of Gaussian noise added to y [y unit^2]");
   sub->add_option("--seed", o->seed, "Seed of the randomized input and the noise");
   sub->add_option("-o,--output", o->out, "Output CSV")->required();
   sub->add_option("--plot", o->plot, "Also render a PNG with gnuplot");
-  return {sub, [o] { return run(*o); }};
+  return {sub, [o, sub] {
+            o->duration_given = sub->get_option("--duration")->count() > 0;
+            return run(*o);
+          }};
 }
 
 }  // namespace lash::cli

@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
     app.set_version_flag("--version", "lash 0.1.0");
     std::vector<Command> commands{
         add_simulate(app),
+        add_excite(app),
         add_demo(app),
         add_closed_loop(app),
         add_tune(app),

@@ -5,6 +5,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include "lash/identify/estimators.hpp"
 #include "lash/io/table.hpp"
 
 namespace lash {
@@ -113,7 +114,89 @@ std::string estimate_text(const EstimateReport& r, double dt_s, const ReportFit&
   return out;
 }
 
-std::string estimate_auto_json(const AutoRun& ar, Preset preset, const ReportFit& fit) {
+SideAdvice side_advice(const AutoRun& ar, Side s, const DataTraits* traits) {
+  SideAdvice a;
+  const EstimateReport& r = ar.run.report;
+  if (r.model != ModelKind::input_deadzone && r.model != ModelKind::output_deadzone &&
+      r.model != ModelKind::deadzone_deadband)
+    return a;
+  const SideReport& sr = s == Side::right ? r.right : r.left;
+  const GuessReport& g = s == Side::right ? ar.right : ar.left;
+  const Reason why = g.wrong_side ? Reason::wrong_guess : sr.params.reason;
+  if (why != Reason::not_updated && why != Reason::not_excited && why != Reason::wrong_guess) return a;
+  a.given = true;
+  a.by_direction = model_traits(r.model).keys_by_direction;
+  for (const auto& [k, n] : sr.updates) {
+    if (k == "-") a.down = n;
+    else a.up = n;
+  }
+  a.min_updates = ar.cfg.min_updates;
+  a.dt_s = ar.cfg.dt_s;
+  a.excite_duration_s = kAdviceExciteDuration;
+  const bool guessed = model_traits(r.model).uses_guesses;
+  if (guessed && g.source != GuessSource::unused && std::isfinite(g.guess)) a.beyond = g.guess;
+  if (r.model == ModelKind::output_deadzone) a.beyond = s == Side::right ? ar.cfg.zero_threshold : -ar.cfg.zero_threshold;
+  if (g.wrong_side && std::isfinite(g.edge)) a.edge_seen = g.edge;
+  // a rough bound per side: the largest of its guess, the edge the guess check saw and its c
+  const auto bound = [&](const SideReport& x, const GuessReport& gx) {
+    double b = std::numeric_limits<double>::quiet_NaN();
+    const auto take = [&](double v) {
+      if (std::isfinite(v) && v != 0.0) b = std::isnan(b) ? std::fabs(v) : std::max(b, std::fabs(v));
+    };
+    if (gx.source != GuessSource::unused) take(gx.guess);
+    take(gx.edge);
+    take(x.params.c);
+    return b;
+  };
+  if (guessed) {
+    a.excite_left = -bound(r.left, ar.left);
+    a.excite_right = bound(r.right, ar.right);
+    if (traits && traits->v_lo < 0.0 && traits->v_hi > 0.0 &&
+        (!(0.5 * traits->v_lo >= a.excite_left) || !(0.5 * traits->v_hi <= a.excite_right))) {
+      a.excite_left = std::min(0.5 * traits->v_lo, std::isnan(a.excite_left) ? 0.0 : a.excite_left);
+      a.excite_right = std::max(0.5 * traits->v_hi, std::isnan(a.excite_right) ? 0.0 : a.excite_right);
+      a.from_input = true;
+    }
+    a.drive_left = 2.0 * a.excite_left;
+    a.drive_right = 2.0 * a.excite_right;
+  }
+  const char* side = s == Side::right ? "right" : "left";
+  const std::string where = std::isfinite(a.beyond) ? fmt::format(" beyond {:+.6g}", a.beyond) : std::string();
+  const auto count = [](std::uint64_t n) { return n == 0 ? std::string("none") : fmt::format("{}", n); };
+  std::string t = fmt::format("{} side: ", side);
+  if (why == Reason::wrong_guess) {
+    t += fmt::format("the guess {:+.6g} lies inside the deadzone (edge seen at {:+.6g}); give --guess-{} beyond the edge, "
+                     "or drive the input further beyond it",
+                     a.beyond, a.edge_seen, side);
+  } else if (a.by_direction) {
+    t += fmt::format("{} update{} moving up{}, {} moving down ({} needed each way)", count(a.up), a.up == 1 ? "" : "s",
+                     where, count(a.down), a.min_updates);
+    if (why == Reason::not_excited)
+      t += "; there the input or the output hardly varied (the regressors were collinear): vary how far beyond the "
+           "edge the input goes";
+    else if (a.up < a.min_updates && a.down < a.min_updates)
+      t += "; drive the input beyond the edge and back, in both directions";
+    else
+      t += fmt::format("; reverse the input while it is beyond the edge, so the output also moves {} there",
+                       a.up < a.min_updates ? "up" : "down");
+  } else {
+    t += fmt::format("{} update{}{} ({} needed)", count(a.up), a.up == 1 ? "" : "s", where, a.min_updates);
+    t += why == Reason::not_excited
+             ? "; there the input or the output hardly varied: vary how far beyond the edge the input goes"
+             : (r.model == ModelKind::output_deadzone ? "; drive the output further to this side, for longer"
+                                                      : "; drive the input further beyond the edge, for longer");
+  }
+  if (std::isfinite(a.drive_left) && std::isfinite(a.drive_right))
+    t += fmt::format(", e.g. a sine between {:.6g} and {:.6g} (lash excite --edges={:.6g},{:.6g} --dt {:.6g} --duration {:.6g}){}",
+                     a.drive_left, a.drive_right, a.excite_left, a.excite_right, a.dt_s, a.excite_duration_s,
+                     a.from_input ? ""
+                                  : "; the bounds are the switching guesses, and the edge of a side not identified may "
+                                    "lie beyond its guess: if it still fails, widen them towards the input's extremes");
+  a.text = std::move(t);
+  return a;
+}
+
+std::string estimate_auto_json(const AutoRun& ar, Preset preset, const ReportFit& fit, const DataTraits* traits) {
   Json j = Json::parse(estimate_json(ar.run.report, fit));
   const auto put_guess = [&](const char* side, const GuessReport& g) {
     if (!j.contains(side) || g.source == GuessSource::unused) return;
@@ -122,12 +205,39 @@ std::string estimate_auto_json(const AutoRun& ar, Preset preset, const ReportFit
   };
   put_guess("right", ar.right);
   put_guess("left", ar.left);
+  const auto put_advice = [&](const char* side, Side s) {
+    if (!j.contains(side)) return;
+    const SideAdvice a = side_advice(ar, s, traits);
+    if (!a.given) {
+      j[side]["advice"] = Json();
+      return;
+    }
+    Json o;
+    o["text"] = a.text;
+    if (a.by_direction) {
+      o["updates_up"] = a.up;
+      o["updates_down"] = a.down;
+    } else {
+      o["updates"] = a.up;
+    }
+    o["min_updates"] = a.min_updates;
+    o["beyond"] = num(a.beyond);
+    o["edge_seen"] = num(a.edge_seen);
+    o["drive"] = {num(a.drive_left), num(a.drive_right)};
+    o["excite_edges"] = {num(a.excite_left), num(a.excite_right)};
+    o["bounds_from"] = a.from_input ? "input" : "guesses";
+    o["dt_s"] = a.dt_s;
+    o["excite_duration_s"] = a.excite_duration_s;
+    j[side]["advice"] = o;
+  };
+  put_advice("right", Side::right);
+  put_advice("left", Side::left);
   j["outliers"] = ar.outliers;
   j["preset"] = to_string(preset);
   return j.dump();
 }
 
-std::string estimate_auto_text(const AutoRun& ar, double dt_s, const ReportFit& fit) {
+std::string estimate_auto_text(const AutoRun& ar, double dt_s, const ReportFit& fit, const DataTraits* traits) {
   std::string out = estimate_text(ar.run.report, dt_s, fit);
   for (const auto& [name, g] : {std::pair{"right", &ar.right}, std::pair{"left", &ar.left}}) {
     if (g->wrong_side)
@@ -135,6 +245,10 @@ std::string estimate_auto_text(const AutoRun& ar, double dt_s, const ReportFit& 
                          g->guess, g->edge);
     else if (g->source != GuessSource::unused)
       out += fmt::format("{} guess: {:.6g} ({})\n", name, g->guess, to_string(g->source));
+  }
+  for (const Side s : {Side::right, Side::left}) {
+    const SideAdvice a = side_advice(ar, s, traits);
+    if (a.given) out += "advice: " + a.text + "\n";
   }
   if (ar.outliers > 0) out += fmt::format("outliers: {} samples of y replaced by the outlier gate\n", ar.outliers);
   return out;

@@ -27,6 +27,22 @@ check string_number  "string_number.toml:4: 'blocks\[0\].left'.*number" $'dt = 0
 check unknown_key    "unknown_key.toml:6: 'blocks\[0\].widht'.*unknown key" $'dt = 0.01\n[[blocks]]\nkind = "deadzone"\nleft = -1\nright = 1\nwidht = 3\n'
 check unknown_input  "'--input'.*unknown input kind 'sawtooth'"    "$ok_plant" --input sawtooth
 check bad_dt_option  "dt"                                          "$ok_plant" --dt -1
+# --input-file (a t,v CSV, e.g. from lash excite): t must step by the plant's dt; v must be numbers
+printf 't,v\n0,1\n0.02,2\n0.04,3\n' > "$d/in_dt.csv"
+check input_file_dt  "'--input-file'.*t steps by 0.02 s, the plant's dt is 0.01 s \(give --dt 0.02\)" "$ok_plant" --input-file "$d/in_dt.csv"
+printf 't,v\n0,1\n0.01,x\n' > "$d/in_text.csv"
+check input_file_text "in_text.csv:3: 'v'"                          "$ok_plant" --input-file "$d/in_text.csv"
+printf 't,x\n0,1\n0.01,2\n' > "$d/in_col.csv"
+check input_file_col "in_col.csv:1: 'v'.*no such column"            "$ok_plant" --input-file "$d/in_col.csv"
+printf 't,v\n0,1e300\n0.01,2\n' > "$d/in_big.csv"
+check input_file_big "'--input-file'.*at most"                      $'dt = 0.01\n[[blocks]]\nkind = "linear"\na1 = -0.5\nb1 = 10\n' --input-file "$d/in_big.csv"
+# and replays the file: v column of the output equals the input's v, then holds the last value
+printf 't,v\n0,1.5\n0.01,-2\n0.02,7\n' > "$d/in_ok.csv"
+printf '%s' "$ok_plant" > "$d/ok.toml"
+v=$("$LASH" simulate "$d/ok.toml" --input-file "$d/in_ok.csv" --duration 0.05 -o - 2>/dev/null | cut -d, -f2 | tr '\n' ' ')
+[[ $v == "v 1.5 -2 7 7 7 " ]] && echo "ok   --input-file replayed: $v" || { echo "FAIL --input-file replay: '$v'"; fail=1; }
+n=$("$LASH" simulate "$d/ok.toml" --input-file "$d/in_ok.csv" -o - 2>/dev/null | wc -l)
+[[ $n -eq 4 ]] && echo "ok   --duration defaults to the file's length" || { echo "FAIL default duration: $n lines"; fail=1; }
 out=$("$LASH" simulate "$d/nope.toml" -o "$d/x.csv" 2>&1); rc=$?
 [[ $rc -eq 2 && $out == *"nope.toml: no such file"* && ! -e $d/x.csv ]] || { echo "FAIL missing file: $rc $out"; fail=1; }
 # An existing output is never replaced by a half-written one.

@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <algorithm>
+#include <limits>
 #include <numbers>
 
 #include "lash/signals/signal.hpp"
@@ -122,4 +124,93 @@ TEST(Rng, GaussianMomentsAndKnownFirstValues) {
   const std::uint64_t s1v = sm();
   const std::uint64_t expect = ((s1v * 5) << 7 | (s1v * 5) >> 57) * 9;
   EXPECT_EQ(q.next(), expect);
+}
+
+// --- lash excite (signals/excite.hpp, docs/excite.md) -------------------------------------------
+#include "lash/signals/excite.hpp"
+
+TEST(Excite, ChecksNameTheField) {
+  ExciteSpec s;
+  s.edge_left = -200, s.edge_right = 300, s.dt_s = 0.005, s.duration_s = 60;
+  EXPECT_FALSE(check_excite(s));
+  const auto field = [](ExciteSpec x) { return check_excite(x) ? check_excite(x)->field : std::string(); };
+  ExciteSpec b = s;
+  b.edge_left = 10;
+  EXPECT_EQ(field(b), "edges");
+  b = s, b.edge_right = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(field(b), "edges");
+  b = s, b.edge_left = -1e308, b.edge_right = 1e308;  // 2x overflows
+  EXPECT_EQ(field(b), "edges");
+  b = s, b.dt_s = 0;
+  EXPECT_EQ(field(b), "dt");
+  b = s, b.dt_s = std::nan("");
+  EXPECT_EQ(field(b), "dt");
+  b = s, b.duration_s = 4 * 2 * std::numbers::pi - 0.01;  // less than 4 default periods
+  EXPECT_EQ(field(b), "duration");
+  b = s, b.duration_s = 4 * 2 * std::numbers::pi;
+  EXPECT_FALSE(check_excite(b));
+  b = s, b.duration_s = 0.005 * (kExciteMaxSamples + 1);
+  EXPECT_EQ(field(b), "duration");
+  b = s, b.period_s = 0.05;  // < 20 dt
+  EXPECT_EQ(field(b), "period");
+  EXPECT_THROW(excite(b), std::invalid_argument);
+  EXPECT_EQ(parse_excite_kind("prbs"), ExciteKind::prbs);
+  EXPECT_THROW(parse_excite_kind("chirp"), std::invalid_argument);
+  EXPECT_DOUBLE_EQ(excite_period(s), 2 * std::numbers::pi);  // max(2 pi, 1000 dt)
+  s.dt_s = 0.01;
+  EXPECT_DOUBLE_EQ(excite_period(s), 10.0);
+}
+
+// The design rule, for every kind: v within reach x the bounds, beyond each bound by a margin,
+// and moving both up and down beyond each bound many times; the same seed gives the same signal.
+TEST(Excite, EveryKindReversesBeyondBothBounds) {
+  for (const ExciteKind kind : {ExciteKind::sine, ExciteKind::multisine, ExciteKind::prbs}) {
+    SCOPED_TRACE(to_string(kind));
+    ExciteSpec s;
+    s.edge_left = -200, s.edge_right = 300, s.dt_s = 0.005, s.duration_s = 120, s.kind = kind, s.seed = 3;
+    const std::vector<double> v = excite(s);
+    ASSERT_EQ(v.size(), 24000u);
+    EXPECT_EQ(v, excite(s));
+    const auto [mn, mx] = std::minmax_element(v.begin(), v.end());
+    EXPECT_GE(*mn, -400.0);
+    EXPECT_LE(*mx, 600.0);
+    EXPECT_LT(*mn, -1.5 * 200);
+    EXPECT_GT(*mx, 1.5 * 300);
+    // moves (v(k) != v(k-1), both beyond the bound) up and down on each side
+    int up_r = 0, down_r = 0, up_l = 0, down_l = 0;
+    for (std::size_t k = 1; k < v.size(); ++k) {
+      if (v[k] > 300 && v[k - 1] > 300) {
+        up_r += v[k] > v[k - 1];
+        down_r += v[k] < v[k - 1];
+      }
+      if (v[k] < -200 && v[k - 1] < -200) {
+        up_l += v[k] > v[k - 1];
+        down_l += v[k] < v[k - 1];
+      }
+    }
+    const int need = kind == ExciteKind::prbs ? 5 : 500;  // prbs moves at level changes only
+    EXPECT_GE(up_r, need);
+    EXPECT_GE(down_r, need);
+    EXPECT_GE(up_l, need);
+    EXPECT_GE(down_l, need);
+    // not two levels: the input takes many values beyond each bound (b1 and the offset separate)
+    std::vector<double> beyond;
+    for (double x : v)
+      if (x > 300) beyond.push_back(x);
+    std::sort(beyond.begin(), beyond.end());
+    EXPECT_GE(std::unique(beyond.begin(), beyond.end()) - beyond.begin(), 5);
+    if (kind != ExciteKind::sine) {
+      ExciteSpec other = s;
+      other.seed = 4;
+      EXPECT_NE(v, excite(other));
+    }
+  }
+}
+
+TEST(Signal, SampledSignalReplaysItsSamples) {
+  const std::vector<double> v{1.5, -2.0, 3.25, 0.0, 7.0};
+  Signal s(sampled_signal(v, 0.003), 0.003);
+  for (double x : v) EXPECT_EQ(s.next(), x);
+  EXPECT_EQ(s.next(), 7.0);  // holds the last value
+  EXPECT_EQ(max_abs_value(sampled_signal(v, 0.003)), 7.0);
 }

@@ -3,6 +3,7 @@
 /// Excitation signals of docs/method.md §A2 (thesis eq. 37 and §1.6.2). Frequencies are
 /// in rad/s; t_k = k·T is computed, never accumulated.
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,10 @@ struct SignalSpec {
 /// |offset| + 12.1·√variance (the polar method's |g| ≤ √(−2 ln s) ≤ 12.01 for its smallest
 /// s = 2⁻¹⁰⁴, and the low-pass is a convex combination). NaN when a parameter is NaN.
 double max_abs_value(const SignalSpec& spec) noexcept;
+
+/// A sampled input as a step sequence: v[k] from t = k·dt_s on (so Signal(spec, dt_s) returns
+/// v[k] at its k-th sample, and the last value after the end). Allocates one level per sample.
+SignalSpec sampled_signal(std::span<const double> v, double dt_s);
 
 /// Generates a signal sample by sample. Not copyable state is cheap; next() is noexcept O(1)
 /// (step sequences advance a cursor, so their cost is amortised O(1)).

@@ -1,0 +1,125 @@
+#!/usr/bin/env python3
+"""Issue 30, "tell the user what to do": a side of a two-sided model not identified because of
+the input (not_updated, not_excited, wrong_guess) carries `advice` in `lash estimate --json`, and
+every count its text prints equals the side's update counts in the same JSON; the text report
+prints the same line; --plot draws with a side missing. A sine of sufficient amplitude gives no
+advice. Records: issue 30's multisine (150 s, 25 random-phase lines 0.05-1.5 Hz scaled to
++-500, seed fixed) and a sine, both run by `lash simulate --input-file` through the plant file
+tests/data/plants/issue30_dz_g_db.toml with noise sigma = 2."""
+import json, os, re, subprocess, sys, tempfile
+
+import numpy as np
+
+LASH = os.environ["LASH"]
+SRC = os.environ["LASH_SOURCE_DIR"]
+PLANT = os.path.join(SRC, "tests/data/plants/issue30_dz_g_db.toml")
+DT = 0.005
+fail = 0
+
+
+def check(cond, what):
+    global fail
+    print(("ok   " if cond else "FAIL ") + what)
+    if not cond:
+        fail = 1
+
+
+def run(*args):
+    return subprocess.run([LASH, *args], capture_output=True, text=True)
+
+
+def record(d, name, v, semicolon):
+    """t,v -> lash simulate (noise sigma 2) -> CSV (semicolon: time;cmd;pos)"""
+    inp = os.path.join(d, name + "_in.csv")
+    t = np.arange(len(v)) * DT
+    with open(inp, "w") as f:
+        f.write("t,v\n")
+        for tk, vk in zip(t, v):
+            f.write(f"{tk!r},{vk!r}\n")
+    sim = os.path.join(d, name + "_sim.csv")
+    p = run("simulate", PLANT, "--input-file", inp, "--noise-variance", "4", "--seed", "7", "-o", sim)
+    check(p.returncode == 0, f"{name}: lash simulate --input-file exits 0 ({p.stderr.strip()})")
+    if not semicolon:
+        return sim
+    out = os.path.join(d, name + ".csv")
+    rows = np.genfromtxt(sim, delimiter=",", names=True)
+    with open(out, "w") as f:
+        f.write("time;cmd;pos\n")
+        for r in rows:
+            f.write(f"{r['t']!r};{r['v']!r};{r['y']!r}\n")
+    return out
+
+
+def g6(x):
+    return f"{x:.6g}"
+
+
+with tempfile.TemporaryDirectory() as d:
+    # issue 30's record
+    n = int(round(150.0 / DT))
+    t = np.arange(n) * DT
+    rng = np.random.default_rng(30)
+    f = np.linspace(0.05, 1.5, 25)
+    ph = rng.uniform(0, 2 * np.pi, 25)
+    x = np.sin(2 * np.pi * np.outer(t, f) + ph).sum(axis=1)
+    v = 500.0 * x / np.abs(x).max()
+    own = record(d, "own", v, True)
+    args = [own, "--columns", "time,cmd,pos", "--model", "deadzone-deadband"]
+    p = run("estimate", *args, "--json")
+    check(p.returncode == 0, f"estimate --json exits 0 ({p.stderr.strip()})")
+    j = json.loads(p.stdout)
+    input_reasons = {"not_updated", "not_excited", "wrong_guess"}
+    advised = 0
+    for side in ("right", "left"):
+        s = j[side]
+        print(f"     {side}: identified {s['identified']} reason {s['reason']} updates {s['updates']}")
+        check("advice" in s, f"{side}: the advice key is present")
+        a = s.get("advice")
+        if s["reason"] not in input_reasons:
+            check(a is None, f"{side}: no advice without an input reason ({s['reason']})")
+            continue
+        advised += 1
+        check(isinstance(a, dict) and a.get("text"), f"{side}: advice given for {s['reason']}: {a and a.get('text')}")
+        if not a:
+            continue
+        check(a["updates_up"] == s["updates"]["+"] and a["updates_down"] == s["updates"]["-"],
+              f"{side}: advice counts {a['updates_up']}/{a['updates_down']} are the side's updates {s['updates']}")
+        if s["reason"] != "wrong_guess":
+            # every count the text prints is an update count of the side (or min_updates)
+            m = re.match(r"\w+ side: (\d+|none) updates? moving up beyond ([-+0-9.e]+), (\d+|none) moving down "
+                         r"\((\d+) needed each way\)", a["text"])
+            check(m is not None, f"{side}: the text states both directions' counts")
+            if m:
+                cnt = lambda w: 0 if w == "none" else int(w)
+                check(cnt(m.group(1)) == s["updates"]["+"] and cnt(m.group(3)) == s["updates"]["-"],
+                      f"{side}: text counts {m.group(1)}/{m.group(3)} == JSON updates {s['updates']}")
+                check(float(m.group(2)) == float(g6(s["guess"]["value"])) and a["beyond"] == s["guess"]["value"],
+                      f"{side}: 'beyond {m.group(2)}' is the side's guess {s['guess']['value']}")
+                check(int(m.group(4)) == a["min_updates"], f"{side}: needed {m.group(4)} == min_updates")
+        if a["drive"][0] is not None:
+            lo, hi = a["excite_edges"]
+            check(f"between {g6(2 * lo)} and {g6(2 * hi)}" in a["text"] and a["drive"] == [2 * lo, 2 * hi],
+                  f"{side}: the suggested sine spans twice the bounds {lo}, {hi}")
+            check(f"--edges={g6(lo)},{g6(hi)}" in a["text"], f"{side}: the lash excite line names the bounds")
+    check(advised >= 1, f"issue 30's record leaves {advised} side(s) unidentified for an input reason")
+    p = run("estimate", *args)
+    lines = [l for l in p.stdout.splitlines() if l.startswith("advice: ")]
+    texts = [j[s]["advice"]["text"] for s in ("right", "left") if j[s].get("advice")]
+    check(lines == ["advice: " + x for x in texts], f"text report prints the JSON's advice: {lines}")
+    png = os.path.join(d, "x.png")
+    p = run("estimate", *args, "--plot", png)
+    check(p.returncode == 0 and os.path.getsize(png) > 1000 and open(png, "rb").read(8) == b"\x89PNG\r\n\x1a\n",
+          f"--plot with a side missing exits {p.returncode} and writes a PNG ({p.stderr.strip()[:200]})")
+
+    # a sine beyond both edges (the thesis's input: 600 sin(t) against edges -150/+220): no advice
+    n = int(round(120.0 / DT))
+    v = 600.0 * np.sin(np.arange(n) * DT)
+    sine = record(d, "sine", v, False)
+    p = run("estimate", sine, "--model", "deadzone-deadband", "--json")
+    j = json.loads(p.stdout)
+    for side in ("right", "left"):
+        check(j[side]["identified"] and j[side]["advice"] is None,
+              f"sine: {side} identified ({j[side]['reason']}), advice {j[side]['advice']}")
+    p = run("estimate", sine, "--model", "deadzone-deadband")
+    check("advice:" not in p.stdout, "sine: the text report has no advice line")
+sys.exit(fail)
