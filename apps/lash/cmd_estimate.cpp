@@ -148,7 +148,7 @@ int run(const CLI::App& sub, const EstimateOptions& o) {
   if (o.json)
     fmt::print("{}\n", e.json);
   else
-    fmt::print("{}", estimate_auto_text(e.run, e.result.dt_s, e.fit));
+    fmt::print("{}", estimate_auto_text(e.run, e.result.dt_s, e.fit, e.traits ? &*e.traits : nullptr));
   std::fflush(stdout);
   if (trace_error) throw *trace_error;
   if (!trace) return kExitOk;

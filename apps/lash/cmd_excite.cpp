@@ -42,10 +42,10 @@ int run(const ExciteOptions& o) {
   if (const auto p = check_excite(spec)) throw InputError("", 0, "--" + p->field, p->message);
   check_output_path(o.out, "--output");
   if (const char* w = excite_warning(spec.kind)) fmt::print(stderr, "lash excite: warning: {}\n", w);
-  const std::vector<double> v = excite(spec);
+  Excitation ex(spec);  // the samples one at a time: memory O(1) in the duration
   CsvStream csv(o.out, {"t", "v"});
-  for (std::size_t k = 0; k < v.size(); ++k) {
-    const double row[2] = {static_cast<double>(k) * spec.dt_s, v[k]};
+  for (std::size_t k = 0; k < ex.samples(); ++k) {
+    const double row[2] = {static_cast<double>(k) * spec.dt_s, ex.next()};
     csv.row(row);
   }
   csv.commit();

@@ -59,7 +59,12 @@ std::vector<StepLevel> parse_steps(const std::string& text) {
 // here, naming the option and its range (exit 2), never written as inf or nan.
 std::string g6(double x) { return fmt::format("{:.6g}", x); }
 
-void check_options(const SimulateOptions& o, const SimulationSpec& spec, const Plant& plant, std::size_t& n) {
+/// Rows of an --input-file held in memory; a longer file is read into a temporary file.
+constexpr std::size_t kInputRowsInMemory = std::size_t{1} << 16;
+
+/// file_max_abs: max |v| of the --input-file (< 0: no file).
+void check_options(const SimulateOptions& o, const SimulationSpec& spec, const Plant& plant, std::size_t& n,
+                   double file_max_abs) {
   auto finite = [](const char* name, double v, const char* unit) {
     if (!std::isfinite(v)) throw InputError("", 0, name, fmt::format("must be a finite number [{}], got {}", unit, v));
   };
@@ -87,7 +92,7 @@ void check_options(const SimulateOptions& o, const SimulationSpec& spec, const P
   }
   // The plant's worst case over n samples (plant/simulate.hpp): the input must keep it below 1e300.
   const double limit = max_input_magnitude(plant, n);
-  const double need = max_abs_value(spec.input);
+  const double need = file_max_abs >= 0.0 ? file_max_abs + std::fabs(o.offset) : max_abs_value(spec.input);
   if (need <= limit) return;
   const OutputBound b = output_bound(plant, n);
   const std::string why =
@@ -125,21 +130,31 @@ int run(const SimulateOptions& o) {
   Plant plant = load_plant(o.plant, o.dt.value_or(0.0));
   SimulationSpec spec;
   double duration = o.duration;
+  // --input-file: its t,v columns in a store (a long file goes to a temporary file, read back in
+  // chunks as the simulation goes: memory does not grow with the file)
+  Table table;       // a short file's columns (the store views them)
+  ColumnStore file;
+  double file_max_abs = 0.0;
   if (!o.input_file.empty()) {
     // the file's v, one sample per plant step: its t must step by the plant's dt
     TableOptions to;
     to.columns = {"t", "v"};
     to.strict = true;
-    const Table tab = read_table(o.input_file, to);
-    const auto& t = tab.cols[0];
-    if (t.size() < 2) throw InputError(o.input_file, 0, "--input-file", "needs at least 2 rows of t,v");
-    const double step = (t.back() - t.front()) / static_cast<double>(t.size() - 1);
+    to.spill_after_rows = kInputRowsInMemory;
+    table = read_table(o.input_file, to);
+    file = table.store();
+    const std::size_t rows = file.rows();
+    if (rows < 2) throw InputError(o.input_file, 0, "--input-file", "needs at least 2 rows of t,v");
+    const double step = (file.back(0) - file.at(0, 0)) / static_cast<double>(rows - 1);
     if (!(std::fabs(step - plant.dt_s()) <= 1e-6 * plant.dt_s()))
       throw InputError(o.input_file, 0, "--input-file",
                        fmt::format("t steps by {} s, the plant's dt is {} s (give --dt {})", format_double(step),
                                    format_double(plant.dt_s()), format_double(step)));
-    spec.input = sampled_signal(tab.cols[1], plant.dt_s());
-    if (!o.duration_given) duration = static_cast<double>(t.size()) * plant.dt_s();
+    for_chunks(file, std::array<std::size_t, 1>{1}, 0, rows, [&](std::size_t, const auto& c) {
+      for (const double x : c[0]) file_max_abs = std::max(file_max_abs, std::fabs(x));
+    });
+    spec.input.kind = Waveform::steps;  // what the file is: a level per sample (for the checks' wording)
+    if (!o.duration_given) duration = static_cast<double>(rows) * plant.dt_s();
   } else {
     try {
       spec.input.kind = parse_waveform(o.input);
@@ -166,11 +181,31 @@ int run(const SimulateOptions& o) {
   spec.noise_variance = o.noise_variance;
   spec.seed = o.seed;
   std::size_t n = 0;
-  check_options(o, spec, plant, n);
+  check_options(o, spec, plant, n, o.input_file.empty() ? -1.0 : file_max_abs);
 
   // Rows go to the file as they are produced: memory O(1) in the duration.
   CsvStream csv(o.out, simulation_columns(plant));
-  simulate_rows(plant, spec, [&](std::span<const double> row) { csv.row(row); });
+  const auto put = [&](std::span<const double> row) { csv.row(row); };
+  if (o.input_file.empty()) {
+    simulate_rows(plant, spec, put);
+  } else {
+    // v(k) = the file's row k (+ --offset), its last value after its end; read in chunks
+    ChunkBuffer<1> buf;
+    std::span<const double> chunk;
+    std::size_t base = 0;
+    const std::size_t rows = file.rows();
+    simulate_rows(
+        plant, spec,
+        [&](std::size_t k) {
+          const std::size_t r = std::min(k, rows - 1);
+          if (r - base >= chunk.size()) {
+            base = r;
+            chunk = buf.get(file, {1}, r, std::min(ColumnStore::kChunkRows, rows - r))[0];
+          }
+          return chunk[r - base] + o.offset;
+        },
+        put);
+  }
   csv.commit();
   if (!o.plot.empty()) {
     plot_csv(o.out, o.plot, "lash simulate " + std::filesystem::path(o.plant).filename().string(),

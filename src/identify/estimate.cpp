@@ -148,7 +148,8 @@ ArrayEstimate estimate_record(const SettingsSources& src, const RecordColumns& r
   out.fit.first_skipped_line = o.first_skipped_line;
   out.fit.gaps = smp.gap_rows.size();
   out.fit.median_dt_s = smp.median_dt;
-  out.json = estimate_auto_json(out.run, set.preset, out.fit);
+  out.traits = set.traits;
+  out.json = estimate_auto_json(out.run, set.preset, out.fit, out.traits ? &*out.traits : nullptr);
   return out;
 }
 

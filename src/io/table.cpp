@@ -28,7 +28,7 @@ std::string header_list(const std::vector<std::string>& names) {
 }
 }  // namespace
 
-ColumnStore Table::store() const {
+ColumnStore Table::store() const& {
   if (spilled.rows()) return spilled;
   std::vector<std::span<const double>> v(cols.begin(), cols.end());
   return ColumnStore(std::move(v));

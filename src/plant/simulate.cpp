@@ -92,25 +92,38 @@ inline void put_row(GaussianNoise& noise, std::size_t k, double v, double y, con
 
 }  // namespace
 
-std::size_t simulate_rows(Plant& plant, const SimulationSpec& spec, const SimulationRowFn& row) {
+namespace {
+// simulate_rows over any input(k) (a Signal's next(), inlined; or a caller's function).
+template <class Input>
+std::size_t simulate_rows_of(Plant& plant, const SimulationSpec& spec, Input input, const SimulationRowFn& row) {
   if (!(std::isfinite(spec.noise_variance) && spec.noise_variance >= 0))
     throw std::invalid_argument("noise variance must be >= 0");
   const std::size_t n = sample_count(spec.duration_s, plant.dt_s());
-  SignalSpec in = spec.input;
-  in.seed = spec.seed;
-  Signal sig(in, plant.dt_s());
   GaussianNoise noise(spec.noise_variance, noise_seed(spec.seed));
   plant.reset();
   const std::size_t nb = plant.blocks().size();
   std::vector<double> r(4 + nb);
   const double dt = plant.dt_s();
   run_chunked(
-      plant, n, [&](std::size_t) { return sig.next(); },
+      plant, n, input,
       [&](std::size_t k, double v, double y, const double* x) {
         put_row(noise, k, v, y, x, nb, dt, r.data());
         row(r);
       });
   return n;
+}
+}  // namespace
+
+std::size_t simulate_rows(Plant& plant, const SimulationSpec& spec, const SimulationRowFn& row) {
+  SignalSpec in = spec.input;
+  in.seed = spec.seed;
+  Signal sig(in, plant.dt_s());
+  return simulate_rows_of(plant, spec, [&sig](std::size_t) { return sig.next(); }, row);
+}
+
+std::size_t simulate_rows(Plant& plant, const SimulationSpec& spec, const SimulationInputFn& input,
+                          const SimulationRowFn& row) {
+  return simulate_rows_of(plant, spec, std::cref(input), row);
 }
 
 SimulationTrace simulate(Plant& plant, std::span<const double> v, double noise_variance, std::uint64_t seed) {

@@ -58,66 +58,82 @@ std::optional<ExciteProblem> check_excite(const ExciteSpec& s) {
   return std::nullopt;
 }
 
-std::vector<double> excite(const ExciteSpec& s) {
+Excitation::Excitation(const ExciteSpec& s) : s_(s) {
   if (const auto p = check_excite(s)) throw std::invalid_argument(p->field + ": " + p->message);
-  const auto n = static_cast<std::size_t>(std::round(s.duration_s / s.dt_s));
+  n_ = static_cast<std::size_t>(std::round(s.duration_s / s.dt_s));
   const double P = excite_period(s);
-  const double lo = s.reach * s.edge_left, hi = s.reach * s.edge_right;
-  std::vector<double> v(n);
+  lo_ = s.reach * s.edge_left;
+  hi_ = s.reach * s.edge_right;
   switch (s.kind) {
-    case ExciteKind::sine: {
-      const double mid = 0.5 * (lo + hi), amp = 0.5 * (hi - lo), w = 2.0 * std::numbers::pi / P;
-      for (std::size_t k = 0; k < n; ++k) v[k] = std::clamp(mid + amp * std::sin(w * static_cast<double>(k) * s.dt_s), lo, hi);
+    case ExciteKind::sine:
+      w_[0] = 2.0 * std::numbers::pi / P;
       break;
-    }
     case ExciteKind::multisine: {
-      // 25 lines log-spaced over [1/(4P), 4/P], random phases; then mapped onto [lo, hi].
-      constexpr int kLines = 25;
+      // 25 lines log-spaced over [1/(4P), 1/P], random phases; then mapped onto [lo, hi].
       Rng rng(s.seed);
-      double f[kLines], phi[kLines];
       for (int i = 0; i < kLines; ++i) {
-        f[i] = 2.0 * std::numbers::pi * (0.25 / P) * std::pow(4.0, i / double(kLines - 1));
-        phi[i] = 2.0 * std::numbers::pi * rng.uniform();
-      }
-      for (std::size_t k = 0; k < n; ++k) {
-        const double t = static_cast<double>(k) * s.dt_s;
-        double x = 0.0;
-        for (int i = 0; i < kLines; ++i) x += std::sin(f[i] * t + phi[i]);
-        v[k] = x;
+        w_[i] = 2.0 * std::numbers::pi * (0.25 / P) * std::pow(4.0, i / double(kLines - 1));
+        phi_[i] = 2.0 * std::numbers::pi * rng.uniform();
       }
       // the 5 % and 95 % quantiles map onto [lo, hi], the tails are clipped there: a multisine's
       // peaks are rare (its crest factor grows with the record), so scaling by its extremes
-      // would keep it inside the deadzone most of the time
-      std::vector<double> sorted = v;
+      // would keep it inside the deadzone most of the time. The quantiles are those of every
+      // sample up to kQuantileSamples samples, else of every stride-th (bounded memory)
+      const std::size_t stride = (n_ + kQuantileSamples - 1) / kQuantileSamples;
+      std::vector<double> sorted;
+      sorted.reserve(n_ / stride + 1);
+      for (std::size_t k = 0; k < n_; k += stride) sorted.push_back(raw(k));
       const auto q = [&](double p) {
-        const auto i = static_cast<std::size_t>(p * static_cast<double>(n - 1));
+        const auto i = static_cast<std::size_t>(p * static_cast<double>(sorted.size() - 1));
         std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(i), sorted.end());
         return sorted[i];
       };
-      const double mn = q(0.05), mx = q(0.95);
-      const double span = mx - mn;
-      for (auto& x : v) x = span > 0.0 ? std::clamp(lo + (x - mn) / span * (hi - lo), lo, hi) : 0.0;
+      mn_ = q(0.05);
+      span_ = q(0.95) - mn_;
       break;
     }
-    case ExciteKind::prbs: {
+    case ExciteKind::prbs:
       // Amplitude-modulated PRBS: x^9 + x^5 + 1 (period 511) picks the side of each hold of P/4,
       // a uniform draw its level in [1.25, 2]/2 of the reach (1.25x to 2x the bound when reach = 2).
-      Rng rng(s.seed);
-      std::uint32_t reg = static_cast<std::uint32_t>(s.seed % 511u) + 1u;
-      const auto hold = std::max<std::size_t>(1, static_cast<std::size_t>(std::round(0.25 * P / s.dt_s)));
-      double level = 0.0;
-      for (std::size_t k = 0; k < n; ++k) {
-        if (k % hold == 0) {
-          const std::uint32_t bit = ((reg >> 8) ^ (reg >> 4)) & 1u;
-          reg = ((reg << 1) | bit) & 0x1FFu;
-          const double frac = 0.625 + 0.375 * rng.uniform();
-          level = bit ? frac * hi : frac * lo;
-        }
-        v[k] = level;
-      }
+      rng_ = Rng(s.seed);
+      reg_ = static_cast<std::uint32_t>(s.seed % 511u) + 1u;
+      hold_ = std::max<std::size_t>(1, static_cast<std::size_t>(std::round(0.25 * P / s.dt_s)));
       break;
-    }
   }
+}
+
+double Excitation::raw(std::size_t k) const noexcept {
+  const double t = static_cast<double>(k) * s_.dt_s;
+  double x = 0.0;
+  for (int i = 0; i < kLines; ++i) x += std::sin(w_[i] * t + phi_[i]);
+  return x;
+}
+
+double Excitation::next() noexcept {
+  const std::size_t k = k_++;
+  switch (s_.kind) {
+    case ExciteKind::sine: {
+      const double mid = 0.5 * (lo_ + hi_), amp = 0.5 * (hi_ - lo_);
+      return std::clamp(mid + amp * std::sin(w_[0] * static_cast<double>(k) * s_.dt_s), lo_, hi_);
+    }
+    case ExciteKind::multisine:
+      return span_ > 0.0 ? std::clamp(lo_ + (raw(k) - mn_) / span_ * (hi_ - lo_), lo_, hi_) : 0.0;
+    case ExciteKind::prbs:
+      if (k % hold_ == 0) {
+        const std::uint32_t bit = ((reg_ >> 8) ^ (reg_ >> 4)) & 1u;
+        reg_ = ((reg_ << 1) | bit) & 0x1FFu;
+        const double frac = 0.625 + 0.375 * rng_.uniform();
+        level_ = bit ? frac * hi_ : frac * lo_;
+      }
+      return level_;
+  }
+  return 0.0;
+}
+
+std::vector<double> excite(const ExciteSpec& s) {
+  Excitation e(s);
+  std::vector<double> v(e.samples());
+  for (auto& x : v) x = e.next();
   return v;
 }
 

@@ -102,6 +102,23 @@ with tempfile.TemporaryDirectory() as d:
                   f"{side}: the suggested sine spans twice the bounds {lo}, {hi}")
             check(f"--edges={g6(lo)},{g6(hi)}" in a["text"], f"{side}: the lash excite line names the bounds")
     check(advised >= 1, f"issue 30's record leaves {advised} side(s) unidentified for an input reason")
+    # Following the advice identifies the plant: its `lash excite` line (bounds from the record's
+    # input range: bounds_from "input") -> simulate through the same plant -> every parameter
+    # within 5 % of the plant file's values (scripts/excite_measure.py reads the truth from it).
+    sys.path.insert(0, os.path.join(SRC, "scripts"))
+    from excite_measure import identify, truth  # noqa: E402
+    a = next(j[s]["advice"] for s in ("right", "left") if j[s].get("advice"))
+    check(a["bounds_from"] == "input", f"the advice's bounds come from the record's input ({a['bounds_from']})")
+    lo, hi = a["excite_edges"]
+    d2 = os.path.join(d, "advised")
+    os.mkdir(d2)
+    ja, worst, _ = identify(LASH, PLANT, f"{lo!r},{hi!r}", "sine", a["excite_duration_s"], d2)
+    tr = truth(PLANT)
+    for side in ("right", "left"):
+        for k, want in tr[side].items():
+            got = ja[side][k]
+            check(ja[side]["identified"] and got is not None and abs(got - want) <= 0.05 * abs(want),
+                  f"following the advice (--edges={lo:.6g},{hi:.6g}): {side} {k} = {got} within 5 % of {want}")
     p = run("estimate", *args)
     lines = [l for l in p.stdout.splitlines() if l.startswith("advice: ")]
     texts = [j[s]["advice"]["text"] for s in ("right", "left") if j[s].get("advice")]

@@ -6,6 +6,7 @@
 /// Python's `Result.to_dict()` cannot drift apart.
 /// Not real-time safe (allocates). Errors are lash::InputError naming file, line and column.
 #include <functional>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -79,6 +80,9 @@ struct ArrayEstimate {
   double estimator_s = 0.0;
   double estimator_cpu_s = 0.0;  ///< CPU time of the calling thread in the same [s] (`--timing`)
   std::string json;       ///< what `lash estimate --json` prints (estimate_auto_json)
+  /// What the record said (analyse_record), when the settings were tuned to it (preset lash): the
+  /// report's advice sizes its example input from the record's input range (side_advice).
+  std::optional<DataTraits> traits;
 };
 
 /// Python's lash.estimate, the library calls in one place: settings checked (before the data),

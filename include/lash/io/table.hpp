@@ -92,8 +92,9 @@ struct Table {
   ColumnStore spilled;
 
   std::size_t rows() const noexcept { return spilled.rows() ? spilled.rows() : cols.empty() ? 0 : cols[0].size(); }
-  /// The columns as a store: views of `cols`, or the spill file.
-  ColumnStore store() const;
+  /// The columns as a store: views of `cols` (the table must outlive it), or the spill file.
+  ColumnStore store() const&;
+  ColumnStore store() const&& = delete;  ///< views of a temporary would dangle
   /// Index of column `name`, or throws InputError naming the file, header line and column.
   std::size_t column(std::string_view name) const;
   const std::vector<double>& operator[](std::string_view name) const { return cols[column(name)]; }

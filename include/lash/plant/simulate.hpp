@@ -53,6 +53,13 @@ using SimulationRowFn = std::function<void(std::span<const double> row)>;
 /// holding inf or nan is ever passed on).
 std::size_t simulate_rows(Plant& plant, const SimulationSpec& spec, const SimulationRowFn& row);
 
+/// The input v(k) of a simulation, asked for in order k = 0, 1, … (e.g. read from a file).
+using SimulationInputFn = std::function<double(std::size_t k)>;
+/// The same with the input from `input` instead of spec.input (its duration, noise and seed are
+/// used); the same bits as a spec.input giving the same values.
+std::size_t simulate_rows(Plant& plant, const SimulationSpec& spec, const SimulationInputFn& input,
+                          const SimulationRowFn& row);
+
 /// A worst-case bound of the plant's output over n samples: |y(k)| ≤ gain·max|v| + offset for
 /// every k < n, for any input v, propagated block by block (deadzone and deadband add their
 /// widths, a first-order lag multiplies by max|b1|·Σ max|a1|^i, a difference by 2/T, a

@@ -10,7 +10,7 @@
 ///    default period is max(2π s, 1000·dt): the thesis's E1 input ω = 1 rad/s at T = 5 ms);
 ///  - it varies beyond the edges (not two levels), so b1 and the offset of each side separate.
 /// Three kinds: `sine` (the default, the thesis's input), `multisine` (random-phase, 25 lines
-/// log-spaced over [1/(4P), 4/P]), `prbs` (an amplitude-modulated PRBS: a maximal-length 9-bit
+/// log-spaced over [1/(4P), 1/P]), `prbs` (an amplitude-modulated PRBS: a maximal-length 9-bit
 /// LFSR picks the side each hold of P/4, a uniform draw the level between 1.25× and 2× the bound).
 /// What each identified in which time is measured in docs/excite.md. Not real-time code.
 #include <cstdint>
@@ -18,6 +18,8 @@
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "lash/signals/rng.hpp"
 
 namespace lash {
 
@@ -55,8 +57,35 @@ struct ExciteProblem {
 /// round(duration/dt) ≤ kExciteMaxSamples.
 std::optional<ExciteProblem> check_excite(const ExciteSpec& spec);
 
-/// The samples v(k), k = 0 … N−1 at t_k = k·dt. Throws std::invalid_argument (the message of
-/// check_excite) for a bad spec. Every value lies in [reach·c_l, reach·c_r].
+/// The samples v(k), k = 0 … N−1 at t_k = k·dt, one at a time (memory O(1) in N; the multisine's
+/// scale is set in the constructor from its 5 % and 95 % quantiles, taken over every sample up
+/// to kQuantileSamples samples and over every ⌈N/kQuantileSamples⌉-th beyond). Throws
+/// std::invalid_argument (the message of check_excite) for a bad spec. Every value lies in
+/// [reach·c_l, reach·c_r].
+class Excitation {
+ public:
+  static constexpr std::size_t kQuantileSamples = std::size_t{1} << 16;
+  explicit Excitation(const ExciteSpec& spec);
+  std::size_t samples() const noexcept { return n_; }
+  /// v(k) for the next k (k = 0, 1, …).
+  double next() noexcept;
+
+ private:
+  static constexpr int kLines = 25;
+  double raw(std::size_t k) const noexcept;  ///< the multisine's sum of lines at sample k
+
+  ExciteSpec s_;
+  std::size_t n_ = 0, k_ = 0;
+  double lo_ = 0.0, hi_ = 0.0;
+  double w_[kLines] = {}, phi_[kLines] = {};  ///< sine: w_[0]; multisine: the lines [rad/s], phases
+  double mn_ = 0.0, span_ = 0.0;              ///< multisine: the 5 % quantile and the 95 % − 5 % span
+  Rng rng_{1};                                ///< prbs: levels
+  std::uint32_t reg_ = 1;                     ///< prbs: the LFSR
+  std::size_t hold_ = 1;                      ///< prbs: samples per level
+  double level_ = 0.0;
+};
+
+/// All the samples of Excitation(spec) in a vector (8 bytes a sample; `lash excite` streams them).
 std::vector<double> excite(const ExciteSpec& spec);
 
 /// A warning for a kind that did not identify the model in the measurements of docs/excite.md
