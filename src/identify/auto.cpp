@@ -8,9 +8,11 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "lash/identify/auto_gate.hpp"
+#include "lash/io/order_statistic.hpp"
 
 namespace lash {
 
@@ -18,120 +20,6 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 bool uses_guesses(ModelKind m) noexcept { return model_traits(m).uses_guesses; }
-
-/// One order statistic of a sequence seen once, exactly, in bounded memory (Floyd & Rivest's
-/// selection, as median_step in io/table.cpp): a bracket [lo, hi] from a small sample of the
-/// sequence; the pass counts the values below lo, equal to lo, equal to hi and above hi and keeps
-/// only those strictly between; the rank is then found in the counts or among the kept few.
-/// `all`: no bracket (too small a sample): every value is kept, as the reference rule does.
-struct Selection {
-  double lo = 0.0, hi = 0.0;
-  bool all = true;
-  std::size_t n = 0, below = 0, at_lo = 0, at_hi = 0, above = 0;
-  std::vector<double> inside;  ///< the values kept: inside[0, kept) (the rest is room to write into)
-  std::size_t kept = 0;
-
-  /// Brackets rank q of the sample `s` (sorted here) with a margin of ~4 standard deviations of
-  /// the sample quantile's rank; expects ~`n_expected` values in the pass.
-  void bracket(std::vector<double>& s, double q, std::size_t n_expected) {
-    constexpr std::size_t kMinSample = 256;
-    if (s.size() < kMinSample) return;  // all: keep every value
-    std::sort(s.begin(), s.end());
-    if (std::isnan(s.front()) || std::isnan(s.back())) return;
-    const double m = static_cast<double>(s.size());
-    const double margin = 4.0 * std::sqrt(m * q * (1.0 - q)) + 8.0;
-    const double r = q * (m - 1.0);
-    const auto i_lo = static_cast<std::size_t>(std::max(0.0, r - margin));
-    const auto i_hi = static_cast<std::size_t>(std::min(m - 1.0, r + margin));
-    lo = s[i_lo];
-    hi = s[i_hi];
-    all = false;
-    inside.resize(static_cast<std::size_t>(static_cast<double>(n_expected) * (static_cast<double>(i_hi - i_lo) + 2.0) / m * 1.25) + 64);
-  }
-  /// Counts x[0..m) against the bracket and keeps the values strictly inside it.
-  void add(const double* x, std::size_t m) {
-    n += m;
-    if (all) {
-      inside.resize(kept);
-      inside.insert(inside.end(), x, x + m);
-      kept = inside.size();
-      return;
-    }
-    // Blocks of 16 values: the counts two lanes at a time (SSE2's width; GCC/Clang vector
-    // extensions, a lane's comparison is −1 where true) without a branch on the data, and whether
-    // any value of the block lies inside; only such a block is searched for them (for the tail
-    // quantiles nearly none is).
-    using V = double __attribute__((vector_size(16)));
-    using M = std::int64_t __attribute__((vector_size(16)));
-    const double l = lo, h = hi;
-    const V lv = {l, l}, hv = {h, h};
-    M c_lt_lo{}, c_le_lo{}, c_lt_hi{}, c_le_hi{}, c_gt_hi{};
-    std::size_t i = 0;
-    for (; i + 16 <= m; i += 16) {
-      M any{};
-      for (std::size_t j = 0; j < 16; j += 2) {
-        V v;
-        std::memcpy(&v, x + i + j, sizeof v);
-        const M lt_l = v < lv, lt_h = v < hv, le_l = v <= lv;
-        c_lt_lo -= lt_l;
-        c_le_lo -= le_l;
-        c_lt_hi -= lt_h;
-        c_le_hi -= v <= hv;
-        c_gt_hi -= v > hv;
-        any |= lt_h & ~le_l;  // lo < v < hi
-      }
-      if (any[0] | any[1]) {  // every value written at the end, the end advanced past those inside
-        if (inside.size() < kept + 16) inside.resize(std::max<std::size_t>(2 * inside.size(), kept + 1024));
-        double* out = inside.data();
-        for (std::size_t j = i; j < i + 16; ++j) {
-          out[kept] = x[j];
-          kept += ((x[j] > l) & (x[j] < h)) ? 1 : 0;
-        }
-      }
-    }
-    const auto sum = [](const M& c) { return static_cast<std::size_t>(c[0] + c[1]); };
-    std::size_t lt_lo = sum(c_lt_lo), le_lo = sum(c_le_lo), lt_hi = sum(c_lt_hi), le_hi = sum(c_le_hi),
-                gt_hi = sum(c_gt_hi);
-    for (; i < m; ++i) {
-      const double v = x[i];
-      lt_lo += v < l ? 1 : 0;
-      le_lo += v <= l ? 1 : 0;
-      lt_hi += v < h ? 1 : 0;
-      le_hi += v <= h ? 1 : 0;
-      gt_hi += v > h ? 1 : 0;
-      if (v > l && v < h) {
-        if (inside.size() <= kept) inside.resize(std::max<std::size_t>(2 * inside.size(), kept + 1024));
-        inside[kept++] = v;
-      }
-    }
-    below += lt_lo;
-    at_lo += le_lo - lt_lo;
-    at_hi += l < h ? le_hi - lt_hi : 0;  // lo == hi: a value equal to both counts once (at lo)
-    above += gt_hi;
-  }
-
-  /// The value of rank ⌊q·(n − 1)⌋; NaN when the bracket missed it (or a value was NaN).
-  double value(double q) {
-    inside.resize(kept);
-    if (n == 0) return 0.0;
-    auto r = static_cast<std::size_t>(q * static_cast<double>(n - 1));
-    const auto nth = [&](std::size_t k) {
-      const auto it = inside.begin() + static_cast<std::ptrdiff_t>(k);
-      std::nth_element(inside.begin(), it, inside.end());
-      return *it;
-    };
-    if (all) return nth(r);
-    constexpr double kMiss = std::numeric_limits<double>::quiet_NaN();
-    if (below + at_lo + inside.size() + at_hi + above != n) return kMiss;  // a NaN
-    if (r < below) return kMiss;
-    r -= below;
-    if (r < at_lo) return lo;
-    r -= at_lo;
-    if (r < inside.size()) return nth(r);
-    r -= inside.size();
-    return r < at_hi ? hi : kMiss;
-  }
-};
 
 /// The sequences analyse_record takes quantiles of, over the finite pairs (v, y) in order, one
 /// value at a time: the last 41 values of y sit in a ring.
@@ -180,8 +68,8 @@ EstimatorConfig preset_config(ModelKind model, Preset preset, double dt_s) {
 }
 
 // The quantiles are exact (the value std::nth_element puts at rank ⌊q·(n − 1)⌋ of a full copy of
-// the sequence), in memory of a few per cent of the record: see Selection and
-// docs/identification.md ("Defaults chosen from the data").
+// the sequence), in memory bounded whatever the record's length: see OrderStatistic
+// (io/order_statistic.hpp) and docs/identification.md ("Defaults chosen from the data").
 DataTraits analyse_record(std::span<const double> v, std::span<const double> y, double dt_s, YEdits ed) {
   const std::size_t n = std::min(v.size(), y.size());
   return analyse_record(RecordColumns::of(v.first(n), y.first(n)), dt_s, ed);
@@ -203,7 +91,9 @@ DataTraits analyse_record(const RecordColumns& rec, double dt_s, YEdits ed) {
   // The five sequences' quantiles (index of the sequence, q)
   constexpr std::array<std::pair<int, double>, 7> kQ{{{0, 0.001}, {0, 0.999}, {1, 0.001}, {1, 0.999},
                                                       {2, 0.5}, {3, 0.9}, {4, 0.9}}};
-  std::array<Selection, 7> sel;
+  auto sel = [&]<std::size_t... I>(std::index_sequence<I...>) {
+    return std::array<OrderStatistic, sizeof...(I)>{OrderStatistic::quantile(kQ[I].second)...};
+  }(std::make_index_sequence<kQ.size()>{});
   {
     // A sample of each sequence at up to kSample evenly spaced rows (rows with a non-finite
     // value are passed over: the sample only places the brackets, the pass decides)
@@ -232,7 +122,7 @@ DataTraits analyse_record(const RecordColumns& rec, double dt_s, YEdits ed) {
     }
     for (std::size_t i = 0; i < kQ.size(); ++i) {
       auto s = smp[static_cast<std::size_t>(kQ[i].first)];
-      sel[i].bracket(s, kQ[i].second, n);
+      sel[i].bracket(s, n);
     }
   }
   // One pass over the record in chunks that stay in the L1 cache: the finite pairs of a chunk,
@@ -277,10 +167,16 @@ DataTraits analyse_record(const RecordColumns& rec, double dt_s, YEdits ed) {
         n_acc += e1 * e0 > 0.0 ? 1 : 0;
       }
       for (std::size_t j = j40; j < m; ++j) rate[j - j40] = std::fabs(yc[j] - yc[j - 40]) / rate_div;
-      for (std::size_t j = j1; j < m && first; ++j) {
-        const double st = std::fabs(yc[j] - yc[j - 1]);
-        n_steps += st > 0.0 ? 1 : 0;
-        min_step = st > 0.0 ? std::min(min_step, st) : min_step;
+      if (first) {  // in locals: kept in registers (the selections' add is in another file)
+        std::size_t ns = n_steps;
+        double ms = min_step;
+        for (std::size_t j = j1; j < m; ++j) {
+          const double st = std::fabs(yc[j] - yc[j - 1]);
+          ns += st > 0.0 ? 1 : 0;
+          ms = st > 0.0 ? std::min(ms, st) : ms;
+        }
+        n_steps = ns;
+        min_step = ms;
       }
       const std::array<std::pair<const double*, std::size_t>, 5> seq{
           {{vb.data(), m}, {yc, m}, {d2.data(), m - j2}, {rate.data(), m - j40}, {acc.data(), n_acc}}};
@@ -301,32 +197,18 @@ DataTraits analyse_record(const RecordColumns& rec, double dt_s, YEdits ed) {
   const std::size_t k = pass(0x7Fu, true);
   d.samples = k;
   if (d.samples < 3) return d;
-  std::array<double, 7> val{};
-  for (std::size_t i = 0; i < kQ.size(); ++i) {
-    val[i] = sel[i].value(kQ[i].second);
-    if (std::isnan(val[i]) && !sel[i].all) {
-      // The bracket missed: a second pass keeps the side the rank lies on, [−inf, lo] or
-      // [hi, +inf], when it holds at most a quarter of the values; else (or with a NaN in the
-      // sequence) every value, as the reference rule does.
-      const Selection& s1 = sel[i];
-      const std::size_t r = static_cast<std::size_t>(kQ[i].second * static_cast<double>(s1.n - 1));
-      const bool no_nan = s1.below + s1.at_lo + s1.inside.size() + s1.at_hi + s1.above == s1.n;
-      Selection s2;
-      if (no_nan && r < s1.below && s1.below <= s1.n / 4) {
-        s2.all = false;
-        s2.lo = -std::numeric_limits<double>::infinity();
-        s2.hi = s1.lo;
-      } else if (no_nan && r >= s1.n - s1.above && s1.above <= s1.n / 4) {
-        s2.all = false;
-        s2.lo = s1.hi;
-        s2.hi = std::numeric_limits<double>::infinity();
-      }
-      sel[i] = std::move(s2);
-      pass(1u << i, false);
-      val[i] = sel[i].value(kQ[i].second);
-    }
-    sel[i] = Selection{};  // free the kept values
+  // A selection whose first pass did not settle its quantile (the sample's bracket missed it, or
+  // more values fell inside than its cap: io/order_statistic.hpp) takes further passes; those
+  // that need one share it.
+  for (unsigned active = 0x7Fu; active != 0;) {
+    unsigned next = 0;
+    for (std::size_t i = 0; i < kQ.size(); ++i)
+      if ((active >> i & 1u) && sel[i].end_pass()) next |= 1u << i;
+    active = next;
+    if (active != 0) pass(active, false);
   }
+  std::array<double, 7> val{};
+  for (std::size_t i = 0; i < kQ.size(); ++i) val[i] = sel[i].value();
   d.v_lo = val[0];
   d.v_hi = val[1];
   d.y_span = val[3] - val[2];

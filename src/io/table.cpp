@@ -13,6 +13,7 @@
 #include "lash/io/csv.hpp"
 #include "lash/io/error.hpp"
 #include "lash/io/mat.hpp"
+#include "lash/io/order_statistic.hpp"
 
 namespace lash {
 
@@ -387,109 +388,73 @@ Table read_table(const std::filesystem::path& path, const TableOptions& options)
 
 namespace {
 
-/// The median of the steps t[i] − t[i−1] by nth_element over a copy of them (the reference rule).
-double median_step_full(std::span<const double> t) {
-  std::vector<double> d(t.size() - 1);
-  for (std::size_t i = 1; i < t.size(); ++i) d[i - 1] = t[i] - t[i - 1];
-  const auto mid = d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2);
-  std::nth_element(d.begin(), mid, d.end());
-  double med = *mid;
-  if (d.size() % 2 == 0) med = 0.5 * (med + *std::max_element(d.begin(), mid));
-  return med;
+/// The steps t[i + 1] − t[i] for i in [begin, begin + count) into out (reads t[begin, begin + count]).
+void read_steps(const TimeSource& t, std::size_t begin, std::size_t count, double* buf, double* out) {
+  const double* x = t.read(begin, count + 1, buf);
+  for (std::size_t i = 0; i < count; ++i) out[i] = x[i + 1] - x[i];
 }
 
-/// Counts of steps against a bracket [lo, hi] of the median (median_step).
-struct StepCounts {
-  std::size_t below = 0, at_lo = 0, at_hi = 0, above = 0;
-};
+constexpr std::size_t kStepChunk = 4096;
 
-/// Counts the steps t[i] − t[i−1] from row i on into `c` until one lies strictly inside (lo, hi);
-/// returns its row (t.size() when none). Not inlined: a loop that calls nothing keeps its counters
-/// in registers, where the caller's loop (which appends to a vector) kept them in memory.
-[[gnu::noinline]] std::size_t count_steps(std::span<const double> t, std::size_t i, double lo, double hi,
-                                          StepCounts& c) noexcept {
-  std::size_t below = 0, at_lo = 0, at_hi = 0, above = 0;
-  const std::size_t hi_apart = lo < hi ? 1 : 0;  // lo == hi: a step equal to both counts once
-  for (; i < t.size(); ++i) {
-    const double d = t[i] - t[i - 1];
-    if (d > lo && d < hi) break;
-    below += d < lo ? 1 : 0;
-    at_lo += d == lo ? 1 : 0;
-    above += d > hi ? 1 : 0;
-    at_hi += d == hi ? hi_apart : 0;
-  }
-  c.below += below;
-  c.at_lo += at_lo;
-  c.at_hi += at_hi;
-  c.above += above;
-  return i;
-}
-
-/// From row i on: the largest |step − med| of the steps up to the first one above gap_above, into
-/// max_dev; returns that step's row (t.size() when none). Not inlined, as count_steps.
-[[gnu::noinline]] std::size_t scan_to_gap(std::span<const double> t, std::size_t i, double gap_above, double med,
+/// From step j on (the step x[j + 1] − x[j], j < m): the largest |step − med| of the steps up to
+/// the first one above gap_above, into max_dev; returns that step's index (m when none). Not
+/// inlined: a loop that calls nothing keeps its maximum in a register, where the caller's loop
+/// (which appends to a vector) kept it in memory.
+[[gnu::noinline]] std::size_t scan_to_gap(const double* x, std::size_t j, std::size_t m, double gap_above, double med,
                                           double& max_dev) noexcept {
-  double m = max_dev;
-  for (; i < t.size(); ++i) {
-    const double step = t[i] - t[i - 1];
+  double mx = max_dev;
+  for (; j < m; ++j) {
+    const double step = x[j + 1] - x[j];
     if (step > gap_above) break;
-    m = std::max(m, std::abs(step - med));
+    mx = std::max(mx, std::abs(step - med));
   }
-  max_dev = m;
-  return i;
+  max_dev = mx;
+  return j;
 }
 
-/// The same median, exactly, without sorting all the steps (Floyd & Rivest's selection): the
-/// median of a strided sample of the steps brackets the true one between two sample values lo ≤ hi;
-/// one pass counts the steps below lo, equal to lo, equal to hi and above hi and keeps only those
-/// strictly between; the median's ranks are then found in those counts or among the kept few.
-/// A uniformly sampled record has nearly all steps equal (or a few values apart): the pass keeps
-/// almost nothing. When the bracket misses (or a step is NaN) it falls back to median_step_full.
-double median_step(std::span<const double> t) {
-  const std::size_t n = t.size() - 1;  // steps
+/// The median of the steps t[i] − t[i−1], exactly: the value nth_element gives on a full copy of
+/// them (rank n/2; for even n the mean with rank n/2 − 1), by OrderStatistic (Floyd & Rivest's
+/// selection): the median of a strided sample of the steps brackets the true one between two
+/// sample values lo ≤ hi; one pass counts the steps below lo, equal to lo, equal to hi and above
+/// hi and keeps only those strictly between; the median's ranks are then found in those counts or
+/// among the kept few. A uniformly sampled record has nearly all steps equal (or a few values
+/// apart): the pass keeps almost nothing. Fewer than 8·2048 steps (or a NaN step in the sample):
+/// every step is kept. A bracket that misses, or more kept steps than OrderStatistic's cap, take
+/// further passes (io/order_statistic.hpp).
+double median_step(const TimeSource& t) {
+  const std::size_t n = t.rows() - 1;  // steps
   constexpr std::size_t kSample = 2048;
-  if (n < 8 * kSample) return median_step_full(t);
-  std::vector<double> smp(kSample);
-  const std::size_t stride = n / kSample;
-  for (std::size_t j = 0; j < kSample; ++j) smp[j] = t[j * stride + 1] - t[j * stride];
-  std::sort(smp.begin(), smp.end());
-  if (std::isnan(smp.front()) || std::isnan(smp.back())) return median_step_full(t);
-  // ±3 standard deviations of the sample median's rank (√kSample / 2 ≈ 23 positions)
-  constexpr std::size_t kMargin = 96;
-  const double lo = smp[kSample / 2 - kMargin], hi = smp[kSample / 2 + kMargin];
-  StepCounts c;
-  std::vector<double> inside;
-  for (std::size_t i = 1; i <= n; ++i) {
-    i = count_steps(t, i, lo, hi, c);
-    if (i <= n) inside.push_back(t[i] - t[i - 1]);
+  OrderStatistic med = OrderStatistic::median();
+  if (n >= 8 * kSample) {
+    std::vector<double> smp(kSample);
+    const std::size_t stride = n / kSample;
+    double buf[2];
+    for (std::size_t j = 0; j < kSample; ++j) read_steps(t, j * stride, 1, buf, &smp[j]);
+    std::sort(smp.begin(), smp.end());
+    // ±3 standard deviations of the sample median's rank (√kSample / 2 ≈ 23 positions)
+    constexpr std::size_t kMargin = 96;
+    if (!std::isnan(smp.front()) && !std::isnan(smp.back())) med.bracket(smp[kSample / 2 - kMargin], smp[kSample / 2 + kMargin]);
   }
-  const std::size_t below = c.below, at_lo = c.at_lo, at_hi = c.at_hi, above = c.above;
-  if (below + at_lo + inside.size() + at_hi + above != n) return median_step_full(t);  // a NaN step
-  // the value of rank r (0-based) of all the steps; NaN when r lies outside [lo, hi]
-  const auto rank = [&](std::size_t r) {
-    if (r < below) return std::numeric_limits<double>::quiet_NaN();
-    r -= below;
-    if (r < at_lo) return lo;
-    r -= at_lo;
-    if (r < inside.size()) {
-      const auto it = inside.begin() + static_cast<std::ptrdiff_t>(r);
-      std::nth_element(inside.begin(), it, inside.end());
-      return *it;
+  std::vector<double> buf(kStepChunk + 1);
+  do {
+    for (std::size_t i = 0; i < n; i += kStepChunk) {
+      const std::size_t c = std::min(kStepChunk, n - i);
+      med.add_steps(t.read(i, c + 1, buf.data()), c);
     }
-    r -= inside.size();
-    if (r < at_hi) return hi;
-    return std::numeric_limits<double>::quiet_NaN();
-  };
-  double med = rank(n / 2);
-  if (n % 2 == 0) med = 0.5 * (med + rank(n / 2 - 1));
-  return std::isnan(med) ? median_step_full(t) : med;
+  } while (med.end_pass());
+  return med.value();
 }
 
 }  // namespace
 
 Sampling analyse_sampling(std::span<const double> t, double gap_factor) {
+  return analyse_sampling(SpanTimeSource(t), gap_factor);
+}
+
+Sampling analyse_sampling(const TimeSource& t, double gap_factor) {
   Sampling s;
-  if (t.size() < 2) return s;
+  const std::size_t rows = t.rows();
+  if (rows < 2) return s;
   const double med = median_step(t);
   s.median_dt = med;
   // dt = (span − the gap steps) / (steps − gaps): without gaps exactly (t.back() − t.front())/(n − 1).
@@ -497,15 +462,23 @@ Sampling analyse_sampling(std::span<const double> t, double gap_factor) {
   // quotient of the largest deviation is the largest quotient, to the bit)
   double gap_sum = 0.0, max_dev = 0.0;
   const double gap_above = gap_factor * med;
-  for (std::size_t i = 1; i < t.size(); ++i) {
-    i = scan_to_gap(t, i, gap_above, med, max_dev);
-    if (i == t.size()) break;
-    s.gap_rows.push_back(i);
-    gap_sum += t[i] - t[i - 1];
+  std::vector<double> buf(kStepChunk + 1);
+  for (std::size_t i = 0; i + 1 < rows; i += kStepChunk) {
+    const std::size_t c = std::min(kStepChunk, rows - 1 - i);
+    const double* x = t.read(i, c + 1, buf.data());
+    for (std::size_t j = 0; j < c; ++j) {
+      j = scan_to_gap(x, j, c, gap_above, med, max_dev);
+      if (j == c) break;
+      s.gap_rows.push_back(i + j + 1);
+      gap_sum += x[j + 1] - x[j];
+    }
   }
   if (med > 0) s.max_jitter = max_dev / med;
-  const std::size_t n = t.size() - 1 - s.gap_rows.size();
-  s.dt = n ? (t.back() - t.front() - gap_sum) / static_cast<double>(n) : med;
+  const std::size_t n = rows - 1 - s.gap_rows.size();
+  double ends[2], b1;
+  ends[0] = *t.read(0, 1, &b1);
+  ends[1] = *t.read(rows - 1, 1, &b1);
+  s.dt = n ? (ends[1] - ends[0] - gap_sum) / static_cast<double>(n) : med;
   return s;
 }
 

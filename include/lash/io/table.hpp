@@ -148,8 +148,41 @@ struct Sampling {
   std::vector<std::size_t> gap_rows;   ///< rows i with t[i] − t[i−1] > kGapFactor·median_dt
 };
 /// Sampling of `t` (at least 2 samples). Steps above gap_factor·median are gaps.
+/// Same as analyse_sampling(SpanTimeSource(t), gap_factor).
 Sampling analyse_sampling(std::span<const double> t, double gap_factor = kGapFactor);
 /// The same of column `column` of a store (read in chunks when it is spilled).
 Sampling analyse_sampling(const ColumnStore& store, std::size_t column, double gap_factor = kGapFactor);
+
+/// A time column read in pieces, so that analyse_sampling needs none of it in memory (a record
+/// streamed from a file). read() is called with any begin (the median's sample reads rows
+/// j·stride and j·stride + 1: a random read), and then in order from row 0 to the end, once
+/// per pass (usually two passes: the median step, then the gaps and jitter; more only when
+/// the median's selection needs them, io/order_statistic.hpp). Every pass must read the same values.
+class TimeSource {
+ public:
+  virtual ~TimeSource() = default;
+  /// Rows of t.
+  virtual std::size_t rows() const = 0;
+  /// t[begin, begin + count) (begin + count ≤ rows()): at the pointer returned, which is `buf`
+  /// (filled, room for `count` values) or the source's own memory, valid until the next call.
+  virtual const double* read(std::size_t begin, std::size_t count, double* buf) const = 0;
+};
+
+/// A TimeSource over a column in memory (read() returns a pointer into it: no copy).
+class SpanTimeSource final : public TimeSource {
+ public:
+  explicit SpanTimeSource(std::span<const double> t) noexcept : t_(t) {}
+  std::size_t rows() const override { return t_.size(); }
+  const double* read(std::size_t begin, std::size_t, double*) const override { return t_.data() + begin; }
+
+ private:
+  std::span<const double> t_;
+};
+
+/// Sampling of the time column `t` read in chunks (see TimeSource): memory bounded whatever its
+/// length (the median step by OrderStatistic, at most 2 MiB of kept steps; chunks of 4096 rows;
+/// gap_rows, one per gap, is the only thing that grows), and the very bits analyse_sampling(span)
+/// gives on the same values.
+Sampling analyse_sampling(const TimeSource& t, double gap_factor = kGapFactor);
 
 }  // namespace lash
