@@ -139,58 +139,58 @@ DataTraits analyse_record(const RecordColumns& rec, double dt_s, YEdits ed) {
     std::size_t e = 0, next_edit = ed.rows.empty() ? kNoEdit : ed.rows[0];
     // the record in chunks of rows (views when in memory); r counts rows of the whole record
     for_chunks(rec.store, rec.vy, 0, n, [&](std::size_t base, const auto& cols) {
-    const std::span<const double> v = cols[0], y = cols[1];
-    const std::size_t n_rows = v.size();
-    for (std::size_t r = 0; r < n_rows;) {
-      std::size_t m = 0;
-      for (; r < n_rows && m < kChunk; ++r) {
-        double yr = y[r];
-        if (base + r == next_edit) [[unlikely]] {
-          yr = ed.values[e++];
-          next_edit = e < ed.rows.size() ? ed.rows[e] : kNoEdit;
+      const std::span<const double> v = cols[0], y = cols[1];
+      const std::size_t n_rows = v.size();
+      for (std::size_t r = 0; r < n_rows;) {
+        std::size_t m = 0;
+        for (; r < n_rows && m < kChunk; ++r) {
+          double yr = y[r];
+          if (base + r == next_edit) [[unlikely]] {
+            yr = ed.values[e++];
+            next_edit = e < ed.rows.size() ? ed.rows[e] : kNoEdit;
+          }
+          if (std::isfinite(v[r]) && std::isfinite(yr)) {
+            vb[m] = v[r];
+            yb[kLead + m] = yr;
+            ++m;
+          }
         }
-        if (std::isfinite(v[r]) && std::isfinite(yr)) {
-          vb[m] = v[r];
-          yb[kLead + m] = yr;
-          ++m;
+        const double* yc = yb.data() + kLead;  // yc[j] = the (k + j)-th finite y; yc[-40..-1] the ones before
+        // |Δ²y| from finite index 2, |Δ₄₀y|/(40T) from 40, |Δ²y|/T² where y moved the same way twice
+        const std::size_t j2 = k >= 2 ? 0 : std::min(m, 2 - k), j40 = k >= 40 ? 0 : std::min(m, 40 - k);
+        const std::size_t j1 = k >= 1 ? 0 : std::min<std::size_t>(m, 1);
+        std::size_t n_acc = 0;
+        for (std::size_t j = j2; j < m; ++j) {
+          d2[j - j2] = std::fabs(yc[j] - 2.0 * yc[j - 1] + yc[j - 2]);
+          const double e1 = yc[j] - yc[j - 1], e0 = yc[j - 1] - yc[j - 2];
+          acc[n_acc] = std::fabs(e1 - e0) / acc_div;
+          n_acc += e1 * e0 > 0.0 ? 1 : 0;
+        }
+        for (std::size_t j = j40; j < m; ++j) rate[j - j40] = std::fabs(yc[j] - yc[j - 40]) / rate_div;
+        if (first) {  // in locals: kept in registers (the selections' add is in another file)
+          std::size_t ns = n_steps;
+          double ms = min_step;
+          for (std::size_t j = j1; j < m; ++j) {
+            const double st = std::fabs(yc[j] - yc[j - 1]);
+            ns += st > 0.0 ? 1 : 0;
+            ms = st > 0.0 ? std::min(ms, st) : ms;
+          }
+          n_steps = ns;
+          min_step = ms;
+        }
+        const std::array<std::pair<const double*, std::size_t>, 5> seq{
+            {{vb.data(), m}, {yc, m}, {d2.data(), m - j2}, {rate.data(), m - j40}, {acc.data(), n_acc}}};
+        for (std::size_t i = 0; i < kQ.size(); ++i) {
+          if (!(active >> i & 1u)) continue;
+          const auto& [x, len] = seq[static_cast<std::size_t>(kQ[i].first)];
+          sel[i].add(x, len);
+        }
+        k += m;
+        if (m > 0) {  // the last 40 finite values of y lead the next chunk
+          const auto from = yb.begin() + static_cast<std::ptrdiff_t>(m);
+          std::copy(from, from + static_cast<std::ptrdiff_t>(kLead), yb.begin());
         }
       }
-      const double* yc = yb.data() + kLead;  // yc[j] = the (k + j)-th finite y; yc[-40..-1] the ones before
-      // |Δ²y| from finite index 2, |Δ₄₀y|/(40T) from 40, |Δ²y|/T² where y moved the same way twice
-      const std::size_t j2 = k >= 2 ? 0 : std::min(m, 2 - k), j40 = k >= 40 ? 0 : std::min(m, 40 - k);
-      const std::size_t j1 = k >= 1 ? 0 : std::min<std::size_t>(m, 1);
-      std::size_t n_acc = 0;
-      for (std::size_t j = j2; j < m; ++j) {
-        d2[j - j2] = std::fabs(yc[j] - 2.0 * yc[j - 1] + yc[j - 2]);
-        const double e1 = yc[j] - yc[j - 1], e0 = yc[j - 1] - yc[j - 2];
-        acc[n_acc] = std::fabs(e1 - e0) / acc_div;
-        n_acc += e1 * e0 > 0.0 ? 1 : 0;
-      }
-      for (std::size_t j = j40; j < m; ++j) rate[j - j40] = std::fabs(yc[j] - yc[j - 40]) / rate_div;
-      if (first) {  // in locals: kept in registers (the selections' add is in another file)
-        std::size_t ns = n_steps;
-        double ms = min_step;
-        for (std::size_t j = j1; j < m; ++j) {
-          const double st = std::fabs(yc[j] - yc[j - 1]);
-          ns += st > 0.0 ? 1 : 0;
-          ms = st > 0.0 ? std::min(ms, st) : ms;
-        }
-        n_steps = ns;
-        min_step = ms;
-      }
-      const std::array<std::pair<const double*, std::size_t>, 5> seq{
-          {{vb.data(), m}, {yc, m}, {d2.data(), m - j2}, {rate.data(), m - j40}, {acc.data(), n_acc}}};
-      for (std::size_t i = 0; i < kQ.size(); ++i) {
-        if (!(active >> i & 1u)) continue;
-        const auto& [x, len] = seq[static_cast<std::size_t>(kQ[i].first)];
-        sel[i].add(x, len);
-      }
-      k += m;
-      if (m > 0) {  // the last 40 finite values of y lead the next chunk
-        const auto from = yb.begin() + static_cast<std::ptrdiff_t>(m);
-        std::copy(from, from + static_cast<std::ptrdiff_t>(kLead), yb.begin());
-      }
-    }
     });
     return k;
   };

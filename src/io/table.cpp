@@ -482,11 +482,26 @@ Sampling analyse_sampling(const TimeSource& t, double gap_factor) {
   return s;
 }
 
+namespace {
+/// A column of a ColumnStore as a TimeSource (a spilled store is read into the caller's buffer).
+class StoreTimeSource final : public TimeSource {
+ public:
+  StoreTimeSource(const ColumnStore& s, std::size_t column) noexcept : s_(s), c_(column) {}
+  std::size_t rows() const override { return s_.rows(); }
+  const double* read(std::size_t begin, std::size_t count, double* buf) const override {
+    s_.read(c_, begin, count, buf);
+    return buf;
+  }
+
+ private:
+  const ColumnStore& s_;
+  std::size_t c_;
+};
+}  // namespace
+
 Sampling analyse_sampling(const ColumnStore& store, std::size_t column, double gap_factor) {
   if (store.in_memory()) return analyse_sampling(store.column(column), gap_factor);
-  std::vector<double> t(store.rows());  // TODO(bounded): chunked median
-  store.read(column, 0, t.size(), t.data());
-  return analyse_sampling(t, gap_factor);
+  return analyse_sampling(StoreTimeSource(store, column), gap_factor);
 }
 
 }  // namespace lash
