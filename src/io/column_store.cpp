@@ -1,6 +1,7 @@
 #include "lash/io/column_store.hpp"
 
 #include <fcntl.h>
+#include <sys/mman.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -34,7 +35,26 @@ class SpillFile {
                        std::string("cannot create the record's temporary spill file: ") + std::strerror(errno));
   }
   ~SpillFile() {
+    if (map_) ::munmap(map_, map_len_);
     if (fd_ >= 0) ::close(fd_);
+  }
+  /// Maps the finished file read-only (passes then read it in place, without a copy); without a
+  /// mapping (mmap refused, e.g. under a low RLIMIT_AS) every read copies through pread.
+  void map(std::size_t bytes) {
+    if (bytes == 0) return;
+    void* p = ::mmap(nullptr, bytes, PROT_READ, MAP_SHARED, fd_, 0);
+    if (p == MAP_FAILED) return;
+    map_ = p;
+    map_len_ = bytes;
+  }
+  /// The mapped doubles at byte offset `at`, or nullptr without a mapping.
+  const double* mapped(off_t at) const noexcept {
+    return map_ ? reinterpret_cast<const double*>(static_cast<const char*>(map_) + at) : nullptr;
+  }
+  /// Drops the mapping's pages of [at, at + bytes) from the process (they stay in the page cache;
+  /// a later touch maps them again): the resident set stays one block whatever the record.
+  void release(off_t at, std::size_t bytes) const noexcept {
+    if (map_ && bytes) ::madvise(static_cast<char*>(map_) + at, bytes, MADV_DONTNEED);
   }
   SpillFile(const SpillFile&) = delete;
   SpillFile& operator=(const SpillFile&) = delete;
@@ -43,41 +63,38 @@ class SpillFile {
     return static_cast<off_t>(((block * columns_ + column) * SpillWriter::kBlockRows + row_in_block) * sizeof(double));
   }
   void write(const double* p, std::size_t n, off_t at) const {
-    const char* b = reinterpret_cast<const char*>(p);
-    std::size_t left = n * sizeof(double);
-    while (left > 0) {
-      const ssize_t w = ::pwrite(fd_, b, left, at);
-      if (w < 0 && errno == EINTR) continue;
-      if (w <= 0)
-        throw InputError(dir_, 0, "TMPDIR",
-                         std::string("cannot write the record's temporary spill file: ") +
-                             (w < 0 ? std::strerror(errno) : "no progress"));
-      b += w;
-      at += w;
-      left -= static_cast<std::size_t>(w);
-    }
+    transfer(const_cast<double*>(p), n, at, "write", [](int fd, char* b, std::size_t len, off_t o) {
+      return ::pwrite(fd, b, len, o);
+    });
   }
   void read(double* p, std::size_t n, off_t at) const {
+    transfer(p, n, at, "read back", [](int fd, char* b, std::size_t len, off_t o) { return ::pread(fd, b, len, o); });
+  }
+  std::size_t columns() const noexcept { return columns_; }
+
+ private:
+  /// n doubles at byte offset `at` through op (pread or pwrite), retried until all are moved.
+  template <class Op>
+  void transfer(double* p, std::size_t n, off_t at, const char* what, Op op) const {
     char* b = reinterpret_cast<char*>(p);
     std::size_t left = n * sizeof(double);
     while (left > 0) {
-      const ssize_t r = ::pread(fd_, b, left, at);
+      const ssize_t r = op(fd_, b, left, at);
       if (r < 0 && errno == EINTR) continue;
       if (r <= 0)
         throw InputError(dir_, 0, "TMPDIR",
-                         std::string("cannot read back the record's temporary spill file: ") +
-                             (r < 0 ? std::strerror(errno) : "short file"));
+                         std::string("cannot ") + what + " the record's temporary spill file: " +
+                             (r < 0 ? std::strerror(errno) : "no progress"));
       b += r;
       at += r;
       left -= static_cast<std::size_t>(r);
     }
   }
-  std::size_t columns() const noexcept { return columns_; }
-
- private:
   std::size_t columns_;
   std::string dir_;
   int fd_ = -1;
+  void* map_ = nullptr;
+  std::size_t map_len_ = 0;
 };
 
 ColumnStore::ColumnStore(std::vector<std::span<const double>> cols) : mem_(std::move(cols)) {
@@ -105,6 +122,21 @@ void ColumnStore::read(std::size_t c, std::size_t begin, std::size_t n, double* 
     begin += m;
     n -= m;
   }
+}
+
+const double* ColumnStore::mapped(std::size_t c, std::size_t begin, std::size_t n) const noexcept {
+  constexpr std::size_t B = SpillWriter::kBlockRows;
+  if (!file_ || c >= file_columns_ || begin > rows_ || n > rows_ - begin || n == 0 || begin % B + n > B) return nullptr;
+  return file_->mapped(file_->offset(begin / B, c, begin % B));
+}
+
+void ColumnStore::release_block(std::size_t row) const noexcept {
+  constexpr std::size_t B = SpillWriter::kBlockRows;
+  if (!file_ || row >= rows_) return;
+  const std::size_t blk = row / B;
+  const std::size_t in_block = std::min(B, rows_ - blk * B);  // the last block's columns end early
+  const off_t at = file_->offset(blk, 0, 0);
+  file_->release(at, ((file_columns_ - 1) * B + in_block) * sizeof(double));
 }
 
 double ColumnStore::at(std::size_t c, std::size_t row) const {
@@ -137,6 +169,10 @@ void SpillWriter::push_columns(const std::vector<std::vector<double>>& cols, std
 ColumnStore SpillWriter::finish() {
   if (!file_) throw std::logic_error("SpillWriter::finish called twice");
   if (fill_ > 0) flush_block();  // the last, partial block
+  if (rows_ > 0) {  // the file ends with the last block's last column
+    const std::size_t last = (rows_ - 1) / kBlockRows;
+    file_->map(static_cast<std::size_t>(file_->offset(last, columns_ - 1, rows_ - last * kBlockRows)));
+  }
   ColumnStore s;
   s.file_ = std::move(file_);
   s.file_columns_ = columns_;

@@ -258,14 +258,6 @@ double OrderStatistic::nth(std::size_t k) {
 bool OrderStatistic::end_pass() {
   if (state_ == State::done) return false;
   ++passes_;
-  const auto finish = [&](double v) {
-    value_ = v;
-    state_ = State::done;
-    std::vector<double>().swap(kept_);
-    std::vector<std::uint64_t>().swap(bins_);
-    kept = 0;
-    return false;
-  };
   if (passes_ == 1) {
     n_ = n_pass_;
   } else if (n_pass_ != n_) {
@@ -283,17 +275,18 @@ bool OrderStatistic::end_pass() {
   return resolve();
 }
 
+bool OrderStatistic::finish(double v) {
+  value_ = v;
+  state_ = State::done;
+  std::vector<double>().swap(kept_);
+  std::vector<std::uint64_t>().swap(bins_);
+  kept = 0;
+  return false;
+}
+
 bool OrderStatistic::resolve() {
   const std::size_t n = n_;
   const std::size_t inside = state_ == State::keep ? kept : in_bins_;
-  const auto done = [&](double v) {
-    value_ = v;
-    state_ = State::done;
-    std::vector<double>().swap(kept_);
-    std::vector<std::uint64_t>().swap(bins_);
-    kept = 0;
-    return false;
-  };
   const bool no_nan = below_ + at_lo_ + inside + at_hi_ + above_ == n;
   const bool first = passes_ == 1 && first_ == State::keep;
   if (!no_nan) {
@@ -302,7 +295,7 @@ bool OrderStatistic::resolve() {
       start_pass(State::keep_all);
       return true;
     }
-    return done(kNaN);
+    return finish(kNaN);
   }
   std::size_t r = median_ ? n / 2 : static_cast<std::size_t>(q_ * static_cast<double>(n - 1));
   // the value of rank k when the counts (and the kept values) give it
@@ -322,7 +315,7 @@ bool OrderStatistic::resolve() {
   const auto miss = [&](bool low_side) {
     // the bracket missed: the side the rank lies on when it holds at most a quarter of the values,
     // else every value (the rule without a cap); then within the cap the same passes as before
-    if (!first) return done(kNaN);  // only the sample's bracket can miss
+    if (!first) return finish(kNaN);  // only the sample's bracket can miss
     const std::size_t side = low_side ? below_ : above_;
     if (side <= n / 4) {
       if (low_side) {
@@ -340,10 +333,10 @@ bool OrderStatistic::resolve() {
   };
   // the median's lower value (even n) once the upper one `x` is known, with n_less values below x
   const auto pair = [&](double x, std::size_t n_less) {
-    if (!median_ || n % 2 != 0) return done(x);
+    if (!median_ || n % 2 != 0) return finish(x);
     double lower;
-    if (known(r - 1, lower)) return done(0.5 * (x + lower));
-    if (r - 1 >= n_less) return done(x);  // ranks r − 1 and r hold the same value
+    if (known(r - 1, lower)) return finish(0.5 * (x + lower));
+    if (r - 1 >= n_less) return finish(x);  // ranks r − 1 and r hold the same value
     upper_ = x;  // the lower value is the largest one below x: one more pass
     start_pass(State::max_below);
     return true;

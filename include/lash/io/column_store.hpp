@@ -22,6 +22,9 @@ namespace lash {
 
 class SpillFile;  // column_store.cpp
 
+/// Rows per block of a spill file (SpillWriter): a block holds its columns one after the other.
+inline constexpr std::size_t kSpillBlockRows = std::size_t{1} << 15;
+
 class ColumnStore {
  public:
   /// Rows per chunk of a pass over a spilled store (16 Ki rows: 128 KiB per column).
@@ -38,6 +41,12 @@ class ColumnStore {
   std::span<const double> column(std::size_t c) const;
   /// Copies rows [begin, begin + n) of column c into out (std::out_of_range beyond rows()).
   void read(std::size_t c, std::size_t begin, std::size_t n, double* out) const;
+  /// Rows [begin, begin + n) of column c in place, for a spilled store that is mapped (read-only
+  /// mmap) when they lie in one block of SpillWriter::kBlockRows rows; nullptr otherwise (read()).
+  const double* mapped(std::size_t c, std::size_t begin, std::size_t n) const noexcept;
+  /// Drops the mapped pages of the block holding `row` from the process (they stay in the page
+  /// cache): a pass releases each block behind it, so its resident memory is one block.
+  void release_block(std::size_t row) const noexcept;
   /// One value (a single read for a spilled store: for bisection, not for passes).
   double at(std::size_t c, std::size_t row) const;
   /// The store's last row of column c (rows() > 0).
@@ -65,16 +74,29 @@ void for_chunks(const ColumnStore& s, const std::array<std::size_t, K>& which, s
     f(begin, std::as_const(cols));
     return;
   }
-  std::vector<double> buf(K * ColumnStore::kChunkRows);
+  // chunks never cross a block of the spill file: in a mapped store they are read in place, and
+  // each block is released when the pass leaves it
+  constexpr std::size_t B = kSpillBlockRows;
+  std::vector<double> buf;
   for (std::size_t b = begin; b < end;) {
-    const std::size_t m = std::min(ColumnStore::kChunkRows, end - b);
-    for (std::size_t i = 0; i < K; ++i) {
-      double* out = buf.data() + i * ColumnStore::kChunkRows;
-      s.read(which[i], b, m, out);
-      cols[i] = std::span<const double>(out, m);
+    const std::size_t m = std::min({ColumnStore::kChunkRows, end - b, B - b % B});
+    bool in_place = true;
+    for (std::size_t i = 0; i < K && in_place; ++i) {
+      const double* p = s.mapped(which[i], b, m);
+      in_place = p != nullptr;
+      cols[i] = std::span<const double>(p, in_place ? m : 0);
+    }
+    if (!in_place) {
+      buf.resize(K * ColumnStore::kChunkRows);
+      for (std::size_t i = 0; i < K; ++i) {
+        double* out = buf.data() + i * ColumnStore::kChunkRows;
+        s.read(which[i], b, m, out);
+        cols[i] = std::span<const double>(out, m);
+      }
     }
     f(b, std::as_const(cols));
     b += m;
+    if (in_place && (b % B == 0 || b == end)) s.release_block(b - 1);
   }
 }
 
@@ -107,7 +129,7 @@ class ChunkBuffer {
 /// full) are lash::InputError naming the directory and the system's reason.
 class SpillWriter {
  public:
-  static constexpr std::size_t kBlockRows = std::size_t{1} << 15;
+  static constexpr std::size_t kBlockRows = kSpillBlockRows;
 
   explicit SpillWriter(std::size_t columns);
   ~SpillWriter();

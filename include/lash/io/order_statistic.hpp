@@ -97,6 +97,8 @@ class OrderStatistic {
   /// After a pass with a bracket: the rank's value from the counts (and the kept values), or the
   /// next pass set up (true).
   bool resolve();
+  /// Settles the result at v, frees the kept values and bins; returns false (no further pass).
+  bool finish(double v);
   double nth(std::size_t k);
 
   double q_;
