@@ -48,14 +48,6 @@ double max_abs_value(const SignalSpec& s) noexcept {
   return std::numeric_limits<double>::quiet_NaN();
 }
 
-SignalSpec sampled_signal(std::span<const double> v, double dt_s) {
-  SignalSpec s;
-  s.kind = Waveform::steps;
-  s.steps.resize(v.size());
-  for (std::size_t k = 0; k < v.size(); ++k) s.steps[k] = {static_cast<double>(k) * dt_s, v[k]};
-  return s;
-}
-
 Signal::Signal(SignalSpec spec, double dt_s) : spec_(std::move(spec)), dt_s_(dt_s), rng_(spec_.seed) {
   auto finite = [](double x) { return std::isfinite(x); };
   if (!(finite(dt_s) && dt_s > 0)) throw std::invalid_argument("dt must be > 0");

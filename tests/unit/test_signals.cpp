@@ -206,11 +206,3 @@ TEST(Excite, EveryKindReversesBeyondBothBounds) {
     }
   }
 }
-
-TEST(Signal, SampledSignalReplaysItsSamples) {
-  const std::vector<double> v{1.5, -2.0, 3.25, 0.0, 7.0};
-  Signal s(sampled_signal(v, 0.003), 0.003);
-  for (double x : v) EXPECT_EQ(s.next(), x);
-  EXPECT_EQ(s.next(), 7.0);  // holds the last value
-  EXPECT_EQ(max_abs_value(sampled_signal(v, 0.003)), 7.0);
-}

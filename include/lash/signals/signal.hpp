@@ -43,9 +43,6 @@ struct SignalSpec {
 /// s = 2⁻¹⁰⁴, and the low-pass is a convex combination). NaN when a parameter is NaN.
 double max_abs_value(const SignalSpec& spec) noexcept;
 
-/// A sampled input as a step sequence: v[k] from t = k·dt_s on (so Signal(spec, dt_s) returns
-/// v[k] at its k-th sample, and the last value after the end). Allocates one level per sample.
-SignalSpec sampled_signal(std::span<const double> v, double dt_s);
 
 /// Generates a signal sample by sample. Not copyable state is cheap; next() is noexcept O(1)
 /// (step sequences advance a cursor, so their cost is amortised O(1)).
