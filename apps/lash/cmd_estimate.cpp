@@ -13,6 +13,7 @@
 #include <fmt/core.h>
 
 #include "cli_common.hpp"
+#include "column_cursor.hpp"
 #include "csv_stream.hpp"
 #include "estimate_plot.hpp"
 #include "estimate_settings.hpp"
@@ -66,13 +67,9 @@ std::size_t spill_after_rows() {
 class TraceWriter {
  public:
   TraceWriter(const std::string& path, std::vector<std::string> names, const ColumnStore& store)
-      : csv_(path, names), store_(store), row_(names.size()), finite_(names.size() - 4, false) {}
+      : csv_(path, names), t_(store, 0), row_(names.size()), finite_(names.size() - 4, false) {}
   void operator()(const TraceRow& r) {
-    if (r.k - t_base_ >= t_.size()) {  // the next chunk of t (views when the record is in memory)
-      t_base_ = r.k;
-      t_ = t_buf_.get(store_, {0}, r.k, std::min(ColumnStore::kChunkRows, store_.rows() - r.k))[0];
-    }
-    row_[0] = t_[r.k - t_base_];
+    row_[0] = t_.at(r.k);
     row_[1] = r.y;
     row_[2] = r.yhat;
     row_[3] = r.ysim;
@@ -87,10 +84,7 @@ class TraceWriter {
 
  private:
   CsvStream csv_;
-  const ColumnStore& store_;
-  ChunkBuffer<1> t_buf_;
-  std::span<const double> t_;
-  std::size_t t_base_ = 0;
+  ColumnCursor t_;  ///< t, read along with the run's rows
   std::vector<double> row_;
   std::vector<bool> finite_;
 };

@@ -7,6 +7,7 @@
 #include <fmt/core.h>
 
 #include "cli_common.hpp"
+#include "column_cursor.hpp"
 #include "csv_stream.hpp"
 #include "plot.hpp"
 #include "lash/plant/plant_file.hpp"
@@ -190,21 +191,9 @@ int run(const SimulateOptions& o) {
     simulate_rows(plant, spec, put);
   } else {
     // v(k) = the file's row k (+ --offset), its last value after its end; read in chunks
-    ChunkBuffer<1> buf;
-    std::span<const double> chunk;
-    std::size_t base = 0;
-    const std::size_t rows = file.rows();
-    simulate_rows(
-        plant, spec,
-        [&](std::size_t k) {
-          const std::size_t r = std::min(k, rows - 1);
-          if (r - base >= chunk.size()) {
-            base = r;
-            chunk = buf.get(file, {1}, r, std::min(ColumnStore::kChunkRows, rows - r))[0];
-          }
-          return chunk[r - base] + o.offset;
-        },
-        put);
+    ColumnCursor v(file, 1);
+    const std::size_t last = file.rows() - 1;
+    simulate_rows(plant, spec, [&](std::size_t k) { return v.at(std::min(k, last)) + o.offset; }, put);
   }
   csv.commit();
   if (!o.plot.empty()) {
