@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "lash/identify/auto_gate.hpp"
+#include "lash/identify/estimators.hpp"
 #include "lash/io/order_statistic.hpp"
 
 namespace lash {
@@ -43,6 +44,87 @@ struct Streams {
     ++k;
   }
 };
+
+using SwitchSide = EstimatorConfig::SwitchSide;
+
+/// A side's raw estimate of a model-switched run: η = [a1, b1, −b1·c, d(1 + a1)].
+SwitchSide raw_switch_side(const AnyEstimator& est, Side s) {
+  const auto* e = est.get<DeadzoneDeadbandEstimator>();
+  if (!e) return {};
+  const auto& eta = e->pooled_rls(s).eta();
+  return {eta[0], eta[1], -eta[2] / eta[1], eta[3] / (1.0 + eta[0])};
+}
+
+/// The model-switching iteration (docs/method.md §A4.4): each run's switching model is the
+/// previous run's estimate (an edge across zero taken as 0, a negative d as 0); a side whose
+/// estimate is not usable (too few updates, unstable) keeps its model and the iteration goes on.
+/// Stops when no parameter moved by more than
+/// kTol of its scale: a1 by (1 − |a1|), b1 by |b1|, c by max(|c|, 10⁻³ of the input span), d by
+/// max(|d|, 10⁻³ of the output span). After kDamp runs the next model is the mean of the last
+/// and the new estimate (a selection that flips between two sample sets then settles between
+/// them). Returns the last model; `rep` gets passes and convergence.
+PerSide<SwitchSide> iterate_switching(const EstimatorConfig& mc0, const RecordColumns& rec,
+                                      PerSide<SwitchSide> model, const DataTraits& d,
+                                      std::span<const std::size_t> gap_rows, YEdits edits, SwitchingReport& rep) {
+  constexpr int kMaxPasses = 40, kDamp = 10;
+  constexpr double kTol = 2e-3;
+  EstimatorConfig mc = mc0;
+  const double vspan = std::max(d.v_hi - d.v_lo, 1e-300), yspan = std::max(d.y_span, 1e-300);
+  rep.tried = true;
+  for (int pass = 1; pass <= kMaxPasses; ++pass) {
+    mc.switch_model = model;
+    AnyEstimator est(mc);
+    step_through(est, rec, 0, rec.size(), gap_rows, [](std::size_t, double, const auto&) {}, edits);
+    rep.passes = pass;
+    bool moved = false;
+    PerSide<SwitchSide> next = model;
+    for (const Side s : {Side::right, Side::left}) {
+      SwitchSide q = raw_switch_side(est, s);
+      // an edge across zero or a negative d: the nearest physical value (a start far off gives
+      // such a first estimate; the next runs move on from it)
+      if (!verdict_rules::physical_edge(q.c, s)) q.c = 0.0;
+      q.d = std::max(q.d, 0.0);
+      if (!(q.usable() && est.updates(s) >= mc.min_updates)) {
+        moved = true;  // a side without an estimate has not converged
+        continue;
+      }
+      SwitchSide& m = model[s];
+      if (pass > kDamp) q = {0.5 * (m.a1 + q.a1), 0.5 * (m.b1 + q.b1), 0.5 * (m.c + q.c), 0.5 * (m.d + q.d)};
+      moved = moved || std::fabs(q.a1 - m.a1) > kTol * (1.0 - std::fabs(m.a1)) ||
+              std::fabs(q.b1 - m.b1) > kTol * std::fabs(m.b1) ||
+              std::fabs(q.c - m.c) > kTol * std::max(std::fabs(m.c), 1e-3 * vspan) ||
+              std::fabs(q.d - m.d) > kTol * std::max(std::fabs(m.d), 1e-3 * yspan);
+      next[s] = q;
+    }
+    model = next;
+    if (!moved) {
+      rep.converged = true;
+      break;
+    }
+  }
+  return model;
+}
+
+/// Where the model-switching iteration starts: an identified side's values, else a1 = −0.9,
+/// b1 = 0.1·K with K = output span / input span, c = 0.3 × the input's extreme on that side, d = 0
+/// (the iteration reaches the same fixed point from far away: docs/method.md §A4.4).
+PerSide<SwitchSide> switching_start(const EstimateReport& r, const DataTraits& d) {
+  const double vspan = d.v_hi - d.v_lo;
+  const double k = vspan > 0.0 && d.y_span > 0.0 ? d.y_span / vspan : 1.0;
+  PerSide<SwitchSide> m;
+  for (const Side s : {Side::right, Side::left}) {
+    const SideParams& p = (s == Side::right ? r.right : r.left).params;
+    if (p.identified && std::isfinite(p.c) && std::isfinite(p.d))
+      m[s] = {p.a1, p.b1, p.c, std::max(p.d, 0.0)};
+    else
+      m[s] = {-0.9, 0.1 * k, 0.3 * (s == Side::right ? std::max(d.v_hi, 0.0) : std::min(d.v_lo, 0.0)), 0.0};
+  }
+  return m;
+}
+
+int sides_identified(const EstimateReport& r) {
+  return (r.right.params.identified ? 1 : 0) + (r.left.params.identified ? 1 : 0);
+}
 
 }  // namespace
 
@@ -331,8 +413,57 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, const RecordColumns& rec, con
     out.right.edge = est.raw_edge(Side::right);
     out.left.edge = est.raw_edge(Side::left);
   };
-  out.run = run_estimator(cfg, rec, ro);
-  if (uses_guesses(cfg.model)) {
+  const bool can_switch = cfg.model == ModelKind::deadzone_deadband && cfg.pooled;
+  if (!can_switch) {
+    out.run = run_estimator(cfg, rec, ro);
+  } else {
+    // First the ẏ switching without what streams or is stored per sample; model switching when it
+    // leaves a side unidentified (or is asked for); the final run again with everything.
+    const bool forced = cfg.model_switching;
+    EstimatorConfig dcfg = cfg;
+    dcfg.model_switching = false;
+    RunOptions probe = ro;
+    probe.keep_trace = probe.keep_outputs = false;
+    probe.on_step = nullptr;
+    EstimationRun direct = run_estimator(dcfg, rec, probe);
+    const bool streams = ro.keep_trace || ro.keep_outputs || static_cast<bool>(ro.on_step);
+    bool use_model = false;
+    if (forced || sides_identified(direct.report) < 2) {
+      const DataTraits d = edit_rows.empty() && o.traits && o.traits->dt_s == cfg.dt_s
+                               ? *o.traits
+                               : analyse_record(rec, cfg.dt_s, edits);
+      EstimatorConfig mc = cfg;
+      mc.model_switching = true;
+      mc.method = EstimationMethod::iv;  // the instrument is the switching model's output
+      mc.noise = NoiseSettings{};        // raw v and y: the instrument, not a filter, handles the noise
+      mc.guess_right = kInf;
+      mc.guess_left = -kInf;
+      mc.switch_model = iterate_switching(mc, rec, switching_start(direct.report, d), d, o.gap_rows, edits,
+                                          out.switching);
+      if (out.switching.converged) {
+        RunOptions mro = ro;
+        mro.at_end = nullptr;  // its edges are not guesses' evidence
+        if (!forced) {  // kept only when it identifies more sides: probe first
+          mro.keep_trace = mro.keep_outputs = false;
+          mro.on_step = nullptr;
+        }
+        EstimationRun m = run_estimator(mc, rec, mro);
+        use_model = forced || sides_identified(m.report) > sides_identified(direct.report);
+        if (use_model) {
+          cfg = mc;
+          out.run = (forced || !streams) ? std::move(m) : run_estimator(mc, rec, ro);
+        }
+      }
+    }
+    out.switching.used = use_model;
+    if (!use_model) {
+      cfg = dcfg;
+      out.run = streams ? run_estimator(dcfg, rec, ro) : std::move(direct);
+    }
+  }
+  if (out.switching.used) {
+    out.right.edge = out.left.edge = detail::kNaN;
+  } else if (uses_guesses(cfg.model)) {
     out.right.guess = cfg.guess_right;
     out.left.guess = cfg.guess_left;
     out.right.source = search_r ? GuessSource::searched : GuessSource::given;

@@ -94,6 +94,15 @@ void DeadzoneDeadbandSettings::validate() const {
   require(std::isfinite(settle_tol) && settle_tol > 0, "settle-tol", "must be > 0");
   require(settle_updates <= 1000000, "settle-updates", "must be <= 1000000");
   require(std::isfinite(singular_tol) && singular_tol > 0, "singular-tol", "must be > 0");
+  require(!model_switching || pooled, "model-switching", "needs pooled = true");
+  require(switch_hold >= 1 && switch_hold <= 1000, "switch-hold", "must be in 1..1000 samples");
+  require(std::isfinite(switch_margin) && switch_margin >= 0 && switch_margin < 1, "switch-margin",
+          "must be in [0, 1)");
+}
+
+bool DeadzoneDeadbandSettings::SwitchSide::usable() const noexcept {
+  return std::isfinite(a1) && std::isfinite(b1) && std::isfinite(c) && std::isfinite(d) && std::fabs(a1) < 1.0 &&
+         b1 != 0.0 && d >= 0.0;
 }
 
 void OutputDeadzoneSettings::validate() const {

@@ -61,6 +61,13 @@ const ConfigField kFields[] = {
    kDzdb, [](C& c) -> Ref { return &c.settle_tol; }},
   {"", "settle_updates", "settle-updates", "deadzone-deadband: settled updates in a row before a side is identified",
    kDzdb, [](C& c) -> Ref { return &c.settle_updates; }, 0, 1000000},
+  {"", "model_switching", "model-switching",
+   "deadzone-deadband: switch on a switching model driven by v (iterated; default: when the dy/dt switching leaves a side unidentified)",
+   kDzdb, [](C& c) -> Ref { return &c.model_switching; }},
+  {"", "switch_hold", "switch-hold", "Model switching: samples the model's deadband must stay engaged one way",
+   kDzdb, [](C& c) -> Ref { return &c.switch_hold; }, 1, 1000},
+  {"", "switch_margin", "switch-margin", "Model switching: v within this share of |c| of an edge updates nothing [-]",
+   kDzdb, [](C& c) -> Ref { return &c.switch_margin; }},
   // OutputDeadzoneSettings
   {"", "zero_threshold", "zero-threshold", "output-deadzone: |y| at or below this counts as 0 [y unit]", kOutDz,
    [](C& c) -> Ref { return &c.zero_threshold; }},

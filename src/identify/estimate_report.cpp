@@ -233,6 +233,14 @@ std::string estimate_auto_json(const AutoRun& ar, Preset preset, const ReportFit
   put_advice("right", Side::right);
   put_advice("left", Side::left);
   j["outliers"] = ar.outliers;
+  if (ar.switching.tried) {
+    const auto& m = ar.cfg.switch_model;
+    Json sw{{"used", ar.switching.used}, {"converged", ar.switching.converged}, {"passes", ar.switching.passes}};
+    if (ar.switching.used)
+      for (const auto& [name, sd] : {std::pair{"right", &m.right}, std::pair{"left", &m.left}})
+        sw["model"][name] = {{"a1", num(sd->a1)}, {"b1", num(sd->b1)}, {"c", num(sd->c)}, {"d", num(sd->d)}};
+    j["model_switching"] = sw;
+  }
   j["preset"] = to_string(preset);
   return j.dump();
 }
@@ -251,6 +259,10 @@ std::string estimate_auto_text(const AutoRun& ar, double dt_s, const ReportFit& 
     if (a.given) out += "advice: " + a.text + "\n";
   }
   if (ar.outliers > 0) out += fmt::format("outliers: {} samples of y replaced by the outlier gate\n", ar.outliers);
+  if (ar.switching.tried)
+    out += fmt::format("model switching: {} after {} runs ({}){}\n", ar.switching.used ? "used" : "not used",
+                       ar.switching.passes, ar.switching.converged ? "converged" : "did not converge",
+                       ar.switching.used ? "" : "; the result is the dy/dt switching's");
   return out;
 }
 

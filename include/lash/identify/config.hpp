@@ -10,6 +10,7 @@
 #include <string>
 #include <string_view>
 
+#include "lash/blocks/side.hpp"
 #include "lash/identify/rls.hpp"
 
 namespace lash {
@@ -146,6 +147,28 @@ struct DeadzoneDeadbandSettings {
   double settle_tol = 0.01;
   std::uint32_t settle_updates = 5;
   double singular_tol = 1e-6;  ///< eq. 31/32: |det| below tol·(|a|+|b|) terms counts as singular
+  /// Model switching (docs/method.md §A4.4, "Model switching"): the side, the direction and the
+  /// instrument of each update come from a switching model (below) driven by v alone, instead of
+  /// ẏ and the guesses; pooled only. `lash estimate` iterates it by itself when the ẏ switching
+  /// leaves a side unidentified; true makes it iterate on every record.
+  bool model_switching = false;
+  /// Model switching: the model's deadband must have been engaged in one direction, with v on
+  /// one side of zero, for this many samples in a row before a sample updates [samples].
+  std::uint32_t switch_hold = 3;
+  /// Model switching: v(k−1) within switch_margin·|c| of the switching model's edge c updates
+  /// nothing [-].
+  double switch_margin = 0.05;
+  /// One side of the switching model: a1, b1 [-], c [v unit], d [y unit].
+  struct SwitchSide {
+    double a1 = std::numeric_limits<double>::quiet_NaN();
+    double b1 = std::numeric_limits<double>::quiet_NaN();
+    double c = std::numeric_limits<double>::quiet_NaN();
+    double d = std::numeric_limits<double>::quiet_NaN();
+    bool usable() const noexcept;  ///< finite, |a1| < 1, b1 ≠ 0, d ≥ 0
+  };
+  /// The switching model, held through a run (not a setting: `lash estimate`'s iteration sets it
+  /// from the previous run). Not usable: model switching updates nothing.
+  PerSide<SwitchSide> switch_model{};
   static constexpr ModelSet models = model_bit(ModelKind::deadzone_deadband);
   void validate() const;
 };

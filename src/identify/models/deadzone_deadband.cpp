@@ -54,6 +54,12 @@ DeadzoneDeadbandModel::DeadzoneDeadbandModel(const EstimatorConfig& cfg)
       pooled_{Rls<4>(cfg.rls4()), Rls<4>(cfg.rls4())},
       pooled_mode_(cfg.pooled) {
   sc_ = {cfg.guess_right, cfg.guess_left};
+  if (cfg.model_switching)  // the free run starts from the switching model
+    for (const Side sd : {Side::right, Side::left})
+      if (const auto& m = cfg.switch_model[sd]; m.usable()) {
+        sc_[sd] = m.c;
+        sim_[sd] = {m.a1, m.b1, m.d};
+      }
 }
 
 // predict_free() and free_run() run on every sample: defined before update() and inlined into
@@ -91,6 +97,8 @@ DeadzoneDeadbandModel::DeadzoneDeadbandModel(const EstimatorConfig& cfg)
 
 [[gnu::always_inline]] inline double DeadzoneDeadbandModel::update(EstimatorCore& c, const Conditioned& s,
                                                                    bool warming) noexcept {
+  if (c.cfg.model_switching) [[unlikely]]
+    return update_switched(c, s, warming);
   const int dir = direction(s.ydot, c.cfg.noise.derivative_threshold);
   const double y1 = c.y1, v1 = c.v1;
   const std::optional<Side> side = detail::guess_side(v1, c.cfg);
@@ -120,6 +128,61 @@ DeadzoneDeadbandModel::DeadzoneDeadbandModel(const EstimatorConfig& cfg)
   return yhat;
 }
 
+double DeadzoneDeadbandModel::update_switched(EstimatorCore& c, const Conditioned& s, bool warming) noexcept {
+  // docs/method.md §A4.4 "Model switching": the switching model (a1, b1, c, d per side, fixed
+  // through the run) is driven by v alone. Its deadband says when the output is pushed up or
+  // down; its edges say which side's regression a sample belongs to, beyond the edge
+  // (φ = [−y(k−1), v(k−1), 1, ∓1]) or inside the deadzone on that side of zero (u = 0:
+  // φ = [−y(k−1), 0, 0, ∓1]); its output ŷ(k−1) is the instrument for y(k−1).
+  const PerSide<EstimatorConfig::SwitchSide>& m = c.cfg.switch_model;
+  const double v1 = c.v1, y1 = c.y1;
+  if (!sw_.started) {  // the first sample (or the first after a gap): the model starts at rest at y
+    sw_ = {};
+    sw_.w = sw_.y = s.y;
+    sw_.started = true;
+    return predict_free(c, last_, y1, v1);
+  }
+  if (!m.right.usable() || !m.left.usable()) return predict_free(c, last_, y1, v1);
+  const double z0 = -sw_.y;  // the model's y(k−1)
+  const Side zs = v1 > m.right.c ? Side::right : (v1 < m.left.c ? Side::left : sw_.last);
+  sw_.last = zs;
+  sw_.w = -m[zs].a1 * sw_.w + m[zs].b1 * detail::deadzone(v1, m.left.c, m.right.c);
+  const bool positive = v1 >= 0.0;
+  const double d = m[positive ? Side::right : Side::left].d;
+  int engaged = 0;
+  if (sw_.w < sw_.y - d) {
+    sw_.y = sw_.w + d;
+    engaged = -1;
+  } else if (sw_.w > sw_.y + d) {
+    sw_.y = sw_.w - d;
+    engaged = 1;
+  }
+  sw_.run = (engaged != 0 && engaged == sw_.engaged && positive == sw_.positive) ? sw_.run + 1 : 0;
+  sw_.engaged = engaged;
+  sw_.positive = positive;
+  // the region of v(k−1): beyond an edge or inside the deadzone, on the side of its sign (the
+  // side whose d acts), clear of the edge by the margin
+  const Side sd = positive ? Side::right : Side::left;
+  const double edge = m[sd].c, sg = positive ? 1.0 : -1.0;
+  const double clear = c.cfg.switch_margin * std::fabs(edge);
+  const bool beyond = sg * (v1 - edge) > clear;
+  const bool inside = sg * (edge - v1) > clear;
+  if (warming || sw_.run < c.cfg.switch_hold || !(beyond || inside)) return predict_free(c, last_, y1, v1);
+  const double b = beyond ? 1.0 : 0.0;
+  const std::array<double, 4> phi{-y1, b * v1, b, engaged > 0 ? -1.0 : 1.0};
+  std::array<double, 4> z = phi;
+  z[0] = z0;
+  const double yhat = pooled_[sd].update_iv(phi, z, s.y);
+  ++count_[key(sd, engaged > 0)];
+  if (beyond) {
+    ++beyond_[sd];
+    c.seen(sd, v1, y1);
+  }
+  if (!usable_[sd] || (++since_[sd] & 7u) == 0) [[unlikely]] refresh(c, sd);
+  last_ = sd;
+  return yhat;
+}
+
 std::uint64_t DeadzoneDeadbandModel::rls_skipped() const noexcept {
   std::uint64_t n = 0;
   for (const auto& r : rls_) n += r.skipped();
@@ -130,7 +193,8 @@ DeadzoneDeadbandModel::Derived DeadzoneDeadbandModel::derive(const EstimatorCore
   const EstimatorConfig& cfg = core.cfg;
   const std::uint64_t np = count_[key(side, true)], nm = count_[key(side, false)];
   Derived q;
-  q.updated = np >= cfg.min_updates && nm >= cfg.min_updates;
+  q.updated = np >= cfg.min_updates && nm >= cfg.min_updates &&
+              (!cfg.model_switching || beyond_[side] >= cfg.min_updates);  // b1 and c need samples beyond the edge
   if (cfg.pooled) {
     // η = [a1, b1, e0, g] with e± = e0 ∓ g, e0 = −b1·c, g = d(1 + a1)
     const auto& e = pooled_[side].eta();
@@ -212,6 +276,7 @@ void DeadzoneDeadbandModel::restart_side(EstimatorCore& c, Side s) noexcept {
     count_[key(s, plus)] = 0;
   }
   pooled_[s].reset();
+  beyond_[s] = 0;
   usable_[s] = false;
   sim_[s] = {};  // no output from that side until its new estimate is usable
   sc_[s] = s == Side::right ? c.cfg.guess_right : c.cfg.guess_left;

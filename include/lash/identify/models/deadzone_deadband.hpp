@@ -53,6 +53,8 @@ class DeadzoneDeadbandModel {
   };
   Derived derive(const EstimatorCore& core, Side s) const noexcept;
   double update(EstimatorCore& c, const Conditioned& s, bool warming) noexcept;
+  /// update() under model switching (EstimatorConfig::model_switching, docs/method.md §A4.4).
+  double update_switched(EstimatorCore& c, const Conditioned& s, bool warming) noexcept;
   void free_run(EstimatorCore& c) noexcept;
   verdict_rules::Evidence evidence(const EstimatorCore& c, Side s) const noexcept;
   /// (c, d) stopped moving (EstimatorConfig::settle_tol): before that a clean verdict is a transient.
@@ -67,6 +69,7 @@ class DeadzoneDeadbandModel {
   void restart() noexcept {
     regime1_ = 0;
     run_ = 0;
+    sw_.started = false;
   }
   void restart_side(EstimatorCore& c, Side s) noexcept;
   void refresh(const EstimatorCore& c, Side s) noexcept;
@@ -89,6 +92,18 @@ class DeadzoneDeadbandModel {
   Side last_ = Side::right, sim_last_ = Side::right;
   int regime1_ = 0;  // the last sample's regime: direction of motion × guess side, 0 = not moving
   std::uint32_t run_ = 0;
+  /// Model switching: the switching model's state (w before and y after its deadband), its last
+  /// engagement (+1 pushed up, −1 down, 0 not), the sign of the v it last read, and how many
+  /// samples in a row it has been engaged one way with v on one side of zero.
+  struct SwitchState {
+    double w = 0.0, y = 0.0;
+    int engaged = 0;
+    bool positive = true, started = false;
+    Side last = Side::right;
+    std::uint32_t run = 0;
+  };
+  SwitchState sw_;
+  PerSide<std::uint64_t> beyond_{};  // model switching: updates with v(k−1) beyond the side's edge
 };
 
 extern template class SwitchingEstimator<DeadzoneDeadbandModel>;
