@@ -57,7 +57,8 @@ SwitchSide raw_switch_side(const AnyEstimator& est, Side s) {
 
 /// The model-switching iteration (docs/method.md §A4.4): each run's switching model is the
 /// previous run's estimate (an edge across zero taken as 0, a negative d as 0); a side whose
-/// estimate is not usable (too few updates, unstable) keeps its model and the iteration goes on.
+/// estimate is not usable (too few updates, unstable) keeps its model; the iteration goes on
+/// unless that side also had none in the run before (an input that never drives a side).
 /// Stops when no parameter moved by more than
 /// kTol of its scale: a1 by (1 − |a1|), b1 by |b1|, c by max(|c|, 10⁻³ of the input span), d by
 /// max(|d|, 10⁻³ of the output span). After kDamp runs the next model is the mean of the last
@@ -71,6 +72,7 @@ PerSide<SwitchSide> iterate_switching(const EstimatorConfig& mc0, const RecordCo
   EstimatorConfig mc = mc0;
   const double vspan = std::max(d.v_hi - d.v_lo, 1e-300), yspan = std::max(d.y_span, 1e-300);
   rep.tried = true;
+  PerSide<bool> had{true, true};  // the side had an estimate in the last run (the start counts)
   for (int pass = 1; pass <= kMaxPasses; ++pass) {
     mc.switch_model = model;
     AnyEstimator est(mc);
@@ -85,11 +87,18 @@ PerSide<SwitchSide> iterate_switching(const EstimatorConfig& mc0, const RecordCo
       if (!verdict_rules::physical_edge(q.c, s)) q.c = 0.0;
       q.d = std::max(q.d, 0.0);
       if (!(q.usable() && est.updates(s) >= mc.min_updates)) {
-        moved = true;  // a side without an estimate has not converged
+        // a side that lost its estimate has not converged; one that had none in two runs in a row
+        // (the input never drives it) does not hold the other up
+        moved = moved || had[s];
+        had[s] = false;
         continue;
       }
+      had[s] = true;
       SwitchSide& m = model[s];
-      if (pass > kDamp) q = {0.5 * (m.a1 + q.a1), 0.5 * (m.b1 + q.b1), 0.5 * (m.c + q.c), 0.5 * (m.d + q.d)};
+      if (pass > kDamp) {  // steps of 1/2, 1/3, …: the model settles where the estimates centre
+        const double g = 1.0 / static_cast<double>(pass - kDamp + 1);
+        q = {m.a1 + g * (q.a1 - m.a1), m.b1 + g * (q.b1 - m.b1), m.c + g * (q.c - m.c), m.d + g * (q.d - m.d)};
+      }
       moved = moved || std::fabs(q.a1 - m.a1) > kTol * (1.0 - std::fabs(m.a1)) ||
               std::fabs(q.b1 - m.b1) > kTol * std::fabs(m.b1) ||
               std::fabs(q.c - m.c) > kTol * std::max(std::fabs(m.c), 1e-3 * vspan) ||
@@ -428,7 +437,9 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, const RecordColumns& rec, con
     EstimationRun direct = run_estimator(dcfg, rec, probe);
     const bool streams = ro.keep_trace || ro.keep_outputs || static_cast<bool>(ro.on_step);
     bool use_model = false;
-    if (forced || sides_identified(direct.report) < 2) {
+    // given guesses are the user's switching: kept (a wrong one is reported as such)
+    const bool given = std::isfinite(cfg0.guess_right) || std::isfinite(cfg0.guess_left);
+    if (forced || (!given && sides_identified(direct.report) < 2)) {
       const DataTraits d = edit_rows.empty() && o.traits && o.traits->dt_s == cfg.dt_s
                                ? *o.traits
                                : analyse_record(rec, cfg.dt_s, edits);

@@ -135,6 +135,7 @@ SideAdvice side_advice(const AutoRun& ar, Side s, const DataTraits* traits) {
   a.excite_duration_s = kAdviceExciteDuration;
   const bool guessed = model_traits(r.model).uses_guesses;
   if (guessed && g.source != GuessSource::unused && std::isfinite(g.guess)) a.beyond = g.guess;
+  if (guessed && ar.switching.used) a.beyond = ar.cfg.switch_model[s].c;  // the switching model's edge
   if (r.model == ModelKind::output_deadzone) a.beyond = s == Side::right ? ar.cfg.zero_threshold : -ar.cfg.zero_threshold;
   if (g.wrong_side && std::isfinite(g.edge)) a.edge_seen = g.edge;
   // a rough bound per side: the largest of its guess, the edge the guess check saw and its c
@@ -144,6 +145,7 @@ SideAdvice side_advice(const AutoRun& ar, Side s, const DataTraits* traits) {
       if (std::isfinite(v) && v != 0.0) b = std::isnan(b) ? std::fabs(v) : std::max(b, std::fabs(v));
     };
     if (gx.source != GuessSource::unused) take(gx.guess);
+    if (ar.switching.used) take(ar.cfg.switch_model[&x == &r.right ? Side::right : Side::left].c);
     take(gx.edge);
     take(x.params.c);
     return b;

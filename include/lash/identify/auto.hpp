@@ -107,7 +107,7 @@ struct AutoOptions {
 };
 
 /// Runs `cfg`'s estimator over v, y. Deadzone-deadband (pooled): when the switching on ẏ leaves a
-/// side unidentified, or cfg.model_switching asks for it, the model switching of docs/method.md
+/// side unidentified (and no guess was given), or cfg.model_switching asks for it, the model switching of docs/method.md
 /// §A4.4 is iterated (the switching model from the previous run's estimate, from a start taken
 /// from the identified sides or the record's ranges, until it moves less than 0.2 % of each
 /// parameter; at most 40 runs, averaged with the previous model after 10); its final run is kept

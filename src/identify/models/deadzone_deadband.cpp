@@ -262,8 +262,11 @@ void DeadzoneDeadbandModel::refresh(const EstimatorCore& c, Side side) noexcept 
   prev_d_[side] = q.d;
   const bool ok = q.usable && settled_[side] >= c.cfg.settle_updates;
   usable_[side] = ok;
-  sim_[side].a1 = q.a1;
-  sim_[side].b1 = q.b1;
+  // model switching: the free run keeps the switching model until the side's own estimate is usable
+  if (!c.cfg.model_switching || ok) {
+    sim_[side].a1 = q.a1;
+    sim_[side].b1 = q.b1;
+  }
   if (ok) {
     sc_[side] = q.c;
     sim_[side].d = q.d > 0.0 ? q.d : 0.0;
