@@ -159,6 +159,21 @@ SideAdvice side_advice(const AutoRun& ar, Side s, const DataTraits* traits) {
       a.excite_right = std::max(0.5 * traits->v_hi, std::isnan(a.excite_right) ? 0.0 : a.excite_right);
       a.from_input = true;
     }
+    // a side with no update at all: its edge may lie beyond the input's reach, so the bound is at
+    // least the input's extreme on that side (the suggested sine then goes twice as far)
+    const auto none = [](const SideReport& x) {
+      std::uint64_t n = 0;
+      for (const auto& [k, c] : x.updates) n += c;
+      return n == 0;
+    };
+    if (traits && none(r.right) && traits->v_hi > 0.0 && !(a.excite_right >= traits->v_hi)) {
+      a.excite_right = traits->v_hi;
+      a.from_input = true;
+    }
+    if (traits && none(r.left) && traits->v_lo < 0.0 && !(a.excite_left <= traits->v_lo)) {
+      a.excite_left = traits->v_lo;
+      a.from_input = true;
+    }
     a.drive_left = 2.0 * a.excite_left;
     a.drive_right = 2.0 * a.excite_right;
   }

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Issue 30, "tell the user what to do": a side of a two-sided model not identified because of
+"""Issue 30's multisine record is identified (model switching); and "tell the user what to do": a side of a two-sided model not identified because of
 the input (not_updated, not_excited, wrong_guess) carries `advice` in `lash estimate --json`, and
 every count its text prints equals the side's update counts in the same JSON; the text report
 prints the same line; --plot draws with a side missing. A sine of sufficient amplitude gives no
@@ -65,6 +65,24 @@ with tempfile.TemporaryDirectory() as d:
     v = 500.0 * x / np.abs(x).max()
     own = record(d, "own", v, True)
     args = [own, "--columns", "time,cmd,pos", "--model", "deadzone-deadband"]
+    # its new outcome: model switching (docs/method.md §A4.4) identifies both sides within issue
+    # 30's bounds (a1 1 %, b1 3 %, c 3 %, d 10 %) of the plant file's values
+    p = run("estimate", *args, "--json")
+    check(p.returncode == 0, f"issue 30's multisine: estimate --json exits 0 ({p.stderr.strip()})")
+    j = json.loads(p.stdout)
+    check(j["model_switching"]["used"] and j["model_switching"]["converged"],
+          f"issue 30's multisine: model switching used ({j['model_switching']})")
+    tr = {"right": dict(a1=-0.97, b1=0.05, c=220.0, d=35.0), "left": dict(a1=-0.97, b1=0.05, c=-150.0, d=20.0)}
+    for side in ("right", "left"):
+        for k, bound in (("a1", 0.01), ("b1", 0.03), ("c", 0.03), ("d", 0.10)):
+            got, want = j[side][k], tr[side][k]
+            check(j[side]["identified"] and got is not None and abs(got / want - 1) <= bound,
+                  f"issue 30's multisine: {side} {k} = {got} within {100 * bound:g} % of {want}")
+    # The advice: the same multisine with its positive half scaled to +180, never beyond the
+    # right edge (+220): the right side cannot be identified from it, for an input reason.
+    v = np.where(x > 0, 180.0 * x / x.max(), 500.0 * x / np.abs(x.min()))
+    own = record(d, "onesided", v, True)
+    args = [own, "--columns", "time,cmd,pos", "--model", "deadzone-deadband"]
     p = run("estimate", *args, "--json")
     check(p.returncode == 0, f"estimate --json exits 0 ({p.stderr.strip()})")
     j = json.loads(p.stdout)
@@ -101,7 +119,8 @@ with tempfile.TemporaryDirectory() as d:
             check(f"between {g6(2 * lo)} and {g6(2 * hi)}" in a["text"] and a["drive"] == [2 * lo, 2 * hi],
                   f"{side}: the suggested sine spans twice the bounds {lo}, {hi}")
             check(f"--edges={g6(lo)},{g6(hi)}" in a["text"], f"{side}: the lash excite line names the bounds")
-    check(advised >= 1, f"issue 30's record leaves {advised} side(s) unidentified for an input reason")
+    check(advised >= 1 and j["right"]["advice"] is not None,
+          f"the one-sided record leaves {advised} side(s) unidentified for an input reason, the right one among them")
     # Following the advice identifies the plant: its `lash excite` line (bounds from the record's
     # input range: bounds_from "input") -> simulate through the same plant -> every parameter
     # within 5 % of the plant file's values (scripts/excite_measure.py reads the truth from it).

@@ -1,0 +1,31 @@
+#!/usr/bin/env python3
+"""Issue 30 item 1, measured: `lash estimate --model deadzone-deadband` with its defaults on 20
+random-phase multisines and 20 random-level step sequences, each through its own random
+DZ -> G -> DB plant (edges 80-300, half-widths 5-50, tau 0.05-0.5 s, K 0.5-3) with E2-level noise
+(scripts/any_input_measure.py). Truth: the plant file's values. A run counts when every side is
+identified with a1 within 1 %, b1 3 %, c 3 %, d 10 % (issue 30's bounds). Floors: what model
+switching reaches today. Before it, the dy/dt switching identified no multisine run and 5 step
+runs, 2 of them within the bounds. The issue's "every seed" is not reached
+(docs/identification.md, "Inputs that are not sines")."""
+import os, sys
+
+SRC = os.environ["LASH_SOURCE_DIR"]
+sys.path.insert(0, os.path.join(SRC, "scripts"))
+from any_input_measure import TOL, run_one  # noqa: E402
+import tempfile  # noqa: E402
+
+LASH = os.environ["LASH"]
+FLOOR = {"multisine": 12, "steps": 15}
+fail = 0
+with tempfile.TemporaryDirectory() as d:
+    for kind, floor in FLOOR.items():
+        good = 0
+        for seed in range(1, 21):
+            r = run_one(LASH, kind, seed, d)
+            ok = r["identified"] and all(r["errs"][f"{k}_{s}"] <= TOL[k] for k in TOL for s in "rl")
+            good += ok
+            print(f"{kind} seed {seed}: {'within' if ok else 'not within'} the bounds; "
+                  + " ".join(f"{k} {100 * v:.2f}%" for k, v in r["errs"].items()))
+        print(("ok   " if good >= floor else "FAIL ") + f"{kind}: {good} of 20 runs within the bounds (floor {floor})")
+        fail |= good < floor
+sys.exit(fail)
