@@ -4,7 +4,7 @@ have: random-phase multisines and random-level steps, through random DZ -> G -> 
 widths and dynamics not from the thesis) with E2-level measurement noise (sigma = 1.4 % of the
 output's amplitude, as E2's variance 200 on E1's +-1000). Prints each run's worst errors and
 returns them; tests/cli/estimate_any_input.py asserts on them.
-usage: any_input_measure.py LASH [seeds] [kind ...]"""
+usage: any_input_measure.py LASH [N | A-B (seeds)] [kind ...]"""
 import json, os, subprocess, sys, tempfile
 
 import numpy as np
@@ -61,7 +61,9 @@ def run_one(lash, kind, seed, d, duration=150.0, amp=500.0):
     sim = subprocess.run([lash, "simulate", pl, "--input-file", inp, "--noise-variance", repr(sigma ** 2),
                           "--seed", str(seed), "-o", rec], capture_output=True, text=True)
     assert sim.returncode == 0, sim.stderr
-    e = subprocess.run([lash, "estimate", rec, "--model", "deadzone-deadband", "--json"], capture_output=True, text=True)
+    extra = os.environ.get("ANY_INPUT_ARGS", "").split()  # settings to compare (exploration)
+    e = subprocess.run([lash, "estimate", rec, "--model", "deadzone-deadband", "--json", *extra], capture_output=True,
+                       text=True)
     assert e.returncode == 0, e.stderr
     j = json.loads(e.stdout)
     truth = {"right": dict(a1=p["a1"], b1=p["b1"], c=p["cr"], d=p["dr"]),
@@ -78,12 +80,13 @@ def run_one(lash, kind, seed, d, duration=150.0, amp=500.0):
 
 def main():
     lash = sys.argv[1]
-    seeds = int(sys.argv[2]) if len(sys.argv) > 2 else 20
+    arg = sys.argv[2] if len(sys.argv) > 2 else "20"  # N (seeds 1..N) or A-B
+    lo, hi = (int(x) for x in arg.split("-")) if "-" in arg else (1, int(arg))
     kinds = sys.argv[3:] or ["multisine", "steps"]
     out = []
     with tempfile.TemporaryDirectory() as d:
         for kind in kinds:
-            for seed in range(1, seeds + 1):
+            for seed in range(lo, hi + 1):
                 r = run_one(lash, kind, seed, d)
                 ok = r["identified"] and all(r["errs"][f"{k}_{s}"] <= TOL[k] for k in TOL for s in "rl")
                 worst = {k: max(r["errs"][f"{k}_r"], r["errs"][f"{k}_l"]) for k in TOL}

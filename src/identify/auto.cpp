@@ -7,6 +7,7 @@
 #include <cstring>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <utility>
 #include <vector>
@@ -56,7 +57,7 @@ SwitchSide raw_switch_side(const AnyEstimator& est, Side s) {
 }
 
 /// The model-switching iteration (docs/method.md §A4.4): each run's switching model is the
-/// previous run's estimate (an edge across zero taken as 0, a negative d as 0); a side whose
+/// previous run's estimate (an edge across zero taken as 0, a negative d as 0, |a1| at most 0.999); a side whose
 /// estimate is not usable (too few updates, unstable) keeps its model; the iteration goes on
 /// unless that side also had none in the run before (an input that never drives a side).
 /// Stops when no parameter moved by more than
@@ -68,7 +69,7 @@ PerSide<SwitchSide> iterate_switching(const EstimatorConfig& mc0, const RecordCo
                                       PerSide<SwitchSide> model, const DataTraits& d,
                                       std::span<const std::size_t> gap_rows, YEdits edits, SwitchingReport& rep) {
   constexpr int kMaxPasses = 40, kDamp = 10;
-  constexpr double kTol = 2e-3;
+  constexpr double kTol = 2e-3, kMaxPole = 0.999;
   EstimatorConfig mc = mc0;
   const double vspan = std::max(d.v_hi - d.v_lo, 1e-300), yspan = std::max(d.y_span, 1e-300);
   rep.tried = true;
@@ -84,8 +85,10 @@ PerSide<SwitchSide> iterate_switching(const EstimatorConfig& mc0, const RecordCo
       SwitchSide q = raw_switch_side(est, s);
       // an edge across zero or a negative d: the nearest physical value (a start far off gives
       // such a first estimate; the next runs move on from it)
+
       if (!verdict_rules::physical_edge(q.c, s)) q.c = 0.0;
       q.d = std::max(q.d, 0.0);
+      q.a1 = std::clamp(q.a1, -kMaxPole, kMaxPole);  // an integrator-like first estimate: the slowest stable lag
       if (!(q.usable() && est.updates(s) >= mc.min_updates)) {
         // a side that lost its estimate has not converged; one that had none in two runs in a row
         // (the input never drives it) does not hold the other up
@@ -114,19 +117,20 @@ PerSide<SwitchSide> iterate_switching(const EstimatorConfig& mc0, const RecordCo
   return model;
 }
 
-/// Where the model-switching iteration starts: an identified side's values, else a1 = −0.9,
-/// b1 = 0.1·K with K = output span / input span, c = 0.3 × the input's extreme on that side, d = 0
-/// (the iteration reaches the same fixed point from far away: docs/method.md §A4.4).
-PerSide<SwitchSide> switching_start(const EstimateReport& r, const DataTraits& d) {
+/// Where the model-switching iteration starts: an identified side's values, else a first-order
+/// lag of `lag` samples (a1 = −exp(−1/lag)), b1 = (1 + a1)·K with K = output span / input span,
+/// c = 0.3 × the input's extreme on that side, d = 0 (docs/method.md §A4.4b).
+PerSide<SwitchSide> switching_start(const EstimateReport& r, const DataTraits& d, double lag) {
   const double vspan = d.v_hi - d.v_lo;
   const double k = vspan > 0.0 && d.y_span > 0.0 ? d.y_span / vspan : 1.0;
+  const double a1 = -std::exp(-1.0 / lag);
   PerSide<SwitchSide> m;
   for (const Side s : {Side::right, Side::left}) {
     const SideParams& p = (s == Side::right ? r.right : r.left).params;
     if (p.identified && std::isfinite(p.c) && std::isfinite(p.d))
       m[s] = {p.a1, p.b1, p.c, std::max(p.d, 0.0)};
     else
-      m[s] = {-0.9, 0.1 * k, 0.3 * (s == Side::right ? std::max(d.v_hi, 0.0) : std::min(d.v_lo, 0.0)), 0.0};
+      m[s] = {a1, (1.0 + a1) * k, 0.3 * (s == Side::right ? std::max(d.v_hi, 0.0) : std::min(d.v_lo, 0.0)), 0.0};
   }
   return m;
 }
@@ -449,21 +453,35 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, const RecordColumns& rec, con
       mc.noise = NoiseSettings{};        // raw v and y: the instrument, not a filter, handles the noise
       mc.guess_right = kInf;
       mc.guess_left = -kInf;
-      mc.switch_model = iterate_switching(mc, rec, switching_start(direct.report, d), d, o.gap_rows, edits,
-                                          out.switching);
-      if (out.switching.converged) {
-        RunOptions mro = ro;
+      // starts with lags of 10, 100, 30 and 300 samples on the sides the ẏ switching left open,
+      // until a converged iteration identifies both sides; else the one that identifies most
+      std::optional<EstimationRun> best;
+      PerSide<SwitchSide> best_model{};
+      for (const double lag : {10.0, 100.0, 30.0, 300.0}) {
+        SwitchingReport rep;
+        mc.switch_model =
+            iterate_switching(mc, rec, switching_start(direct.report, d, lag), d, o.gap_rows, edits, rep);
+        out.switching.passes += rep.passes;
+        ++out.switching.starts;
+        if (!rep.converged) continue;
+        out.switching.converged = true;
+        RunOptions mro = probe;
         mro.at_end = nullptr;  // its edges are not guesses' evidence
-        if (!forced) {  // kept only when it identifies more sides: probe first
-          mro.keep_trace = mro.keep_outputs = false;
-          mro.on_step = nullptr;
-        }
         EstimationRun m = run_estimator(mc, rec, mro);
-        use_model = forced || sides_identified(m.report) > sides_identified(direct.report);
-        if (use_model) {
-          cfg = mc;
-          out.run = (forced || !streams) ? std::move(m) : run_estimator(mc, rec, ro);
+        if (!best || sides_identified(m.report) > sides_identified(best->report)) {
+          best = std::move(m);
+          best_model = mc.switch_model;
         }
+        if (sides_identified(best->report) == 2) break;
+      }
+      out.switching.tried = true;
+      use_model = best && (forced || sides_identified(best->report) > sides_identified(direct.report));
+      if (use_model) {
+        mc.switch_model = best_model;
+        cfg = mc;
+        RunOptions mro = ro;
+        mro.at_end = nullptr;
+        out.run = streams ? run_estimator(mc, rec, mro) : std::move(*best);
       }
     }
     out.switching.used = use_model;

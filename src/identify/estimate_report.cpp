@@ -159,9 +159,11 @@ SideAdvice side_advice(const AutoRun& ar, Side s, const DataTraits* traits) {
       a.excite_right = std::max(0.5 * traits->v_hi, std::isnan(a.excite_right) ? 0.0 : a.excite_right);
       a.from_input = true;
     }
-    // a side with no update at all: its edge may lie beyond the input's reach, so the bound is at
+    // a side with no update at all, or left open by model switching (whose samples inside the
+    // deadzone count as updates): its edge may lie beyond the input's reach, so the bound is at
     // least the input's extreme on that side (the suggested sine then goes twice as far)
-    const auto none = [](const SideReport& x) {
+    const auto none = [&](const SideReport& x) {
+      if (ar.switching.used) return !x.params.identified;
       std::uint64_t n = 0;
       for (const auto& [k, c] : x.updates) n += c;
       return n == 0;
@@ -252,7 +254,10 @@ std::string estimate_auto_json(const AutoRun& ar, Preset preset, const ReportFit
   j["outliers"] = ar.outliers;
   if (ar.switching.tried) {
     const auto& m = ar.cfg.switch_model;
-    Json sw{{"used", ar.switching.used}, {"converged", ar.switching.converged}, {"passes", ar.switching.passes}};
+    Json sw{{"used", ar.switching.used},
+            {"converged", ar.switching.converged},
+            {"passes", ar.switching.passes},
+            {"starts", ar.switching.starts}};
     if (ar.switching.used)
       for (const auto& [name, sd] : {std::pair{"right", &m.right}, std::pair{"left", &m.left}})
         sw["model"][name] = {{"a1", num(sd->a1)}, {"b1", num(sd->b1)}, {"c", num(sd->c)}, {"d", num(sd->d)}};

@@ -111,8 +111,11 @@ with tempfile.TemporaryDirectory() as d:
                 cnt = lambda w: 0 if w == "none" else int(w)
                 check(cnt(m.group(1)) == s["updates"]["+"] and cnt(m.group(3)) == s["updates"]["-"],
                       f"{side}: text counts {m.group(1)}/{m.group(3)} == JSON updates {s['updates']}")
-                check(float(m.group(2)) == float(g6(s["guess"]["value"])) and a["beyond"] == s["guess"]["value"],
-                      f"{side}: 'beyond {m.group(2)}' is the side's guess {s['guess']['value']}")
+                # the side's switching edge: its guess, or under model switching the switching model's c
+                ms = j.get("model_switching") or {}
+                edge = ms["model"][side]["c"] if ms.get("used") else s["guess"]["value"]
+                check(float(m.group(2)) == float(g6(edge)) and a["beyond"] == edge,
+                      f"{side}: 'beyond {m.group(2)}' is the side's switching edge {edge}")
                 check(int(m.group(4)) == a["min_updates"], f"{side}: needed {m.group(4)} == min_updates")
         if a["drive"][0] is not None:
             lo, hi = a["excite_edges"]

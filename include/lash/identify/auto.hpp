@@ -80,7 +80,8 @@ struct SwitchingReport {
   bool tried = false;      ///< the iteration ran (deadzone-deadband, pooled)
   bool used = false;       ///< the final run switched on the model (else on ẏ and the guesses)
   bool converged = false;  ///< the switching model stopped moving (within the tolerance)
-  int passes = 0;          ///< runs over the record the iteration took
+  int passes = 0;          ///< runs over the record the iterations took (all starts)
+  int starts = 0;          ///< starting models tried (lags of 10, 100, 30, 300 samples)
 };
 struct AutoRun {
   EstimatorConfig cfg;         ///< the settings of the final run (what --print-config writes)
@@ -108,10 +109,10 @@ struct AutoOptions {
 
 /// Runs `cfg`'s estimator over v, y. Deadzone-deadband (pooled): when the switching on ẏ leaves a
 /// side unidentified (and no guess was given), or cfg.model_switching asks for it, the model switching of docs/method.md
-/// §A4.4 is iterated (the switching model from the previous run's estimate, from a start taken
+/// §A4.4b is iterated (the switching model from the previous run's estimate, from a start taken
 /// from the identified sides or the record's ranges, until it moves less than 0.2 % of each
-/// parameter; at most 40 runs, averaged with the previous model after 10); its final run is kept
-/// when it converged and identifies more sides (or was asked for). For input-deadzone and deadzone-deadband, a side whose
+/// parameter; at most 40 runs, with shrinking steps after 10; up to four starts); its final run
+/// is kept when it converged and identifies more sides (or was asked for). For input-deadzone and deadzone-deadband, a side whose
 /// guess is infinite is searched: pass 0 uses c* = 0.7·(v quantile of that side); each pass sets
 /// c* = ĉ + max(margin, 0.15·(v_extreme − ĉ)) from the side's identified edge ĉ, or moves c*
 /// halfway out when ĉ lies beyond c* (inside-the-deadzone guess), until c* moves less than 1 %

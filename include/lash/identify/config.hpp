@@ -154,7 +154,7 @@ struct DeadzoneDeadbandSettings {
   bool model_switching = false;
   /// Model switching: the model's deadband must have been engaged in one direction, with v on
   /// one side of zero, for this many samples in a row before a sample updates [samples].
-  std::uint32_t switch_hold = 3;
+  std::uint32_t switch_hold = 4;
   /// Model switching: v(k−1) within switch_margin·|c| of the switching model's edge c updates
   /// nothing [-].
   double switch_margin = 0.05;
