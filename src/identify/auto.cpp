@@ -47,6 +47,7 @@ struct Streams {
 };
 
 using SwitchSide = EstimatorConfig::SwitchSide;
+constexpr int kSwitchBudget = 80;  // runs after which no further start is tried
 
 /// A side's raw estimate of a model-switched run: η = [a1, b1, −b1·c, d(1 + a1)].
 SwitchSide raw_switch_side(const AnyEstimator& est, Side s) {
@@ -56,15 +57,15 @@ SwitchSide raw_switch_side(const AnyEstimator& est, Side s) {
   return {eta[0], eta[1], -eta[2] / eta[1], eta[3] / (1.0 + eta[0])};
 }
 
-/// The model-switching iteration (docs/method.md §A4.4): each run's switching model is the
-/// previous run's estimate (an edge across zero taken as 0, a negative d as 0, |a1| at most 0.999); a side whose
-/// estimate is not usable (too few updates, unstable) keeps its model; the iteration goes on
-/// unless that side also had none in the run before (an input that never drives a side).
-/// Stops when no parameter moved by more than
-/// kTol of its scale: a1 by (1 − |a1|), b1 by |b1|, c by max(|c|, 10⁻³ of the input span), d by
-/// max(|d|, 10⁻³ of the output span). After kDamp runs the next model is the mean of the last
-/// and the new estimate (a selection that flips between two sample sets then settles between
-/// them). Returns the last model; `rep` gets passes and convergence.
+/// The model-switching iteration (docs/method.md §A4.4b): each run's switching model is the
+/// previous run's estimate (an edge across zero taken as 0, a negative d as 0, |a1| at most
+/// 0.999). A side whose estimate is not usable (too few updates, unstable) keeps its model; the
+/// iteration goes on unless that side also had none in the run before (an input that never
+/// drives a side). Stops when no parameter moved by more than kTol of its scale: a1 by
+/// (1 − |a1|), b1 by |b1|, c by max(|c|, 10⁻³ of the input span), d by max(|d|, 10⁻³ of the
+/// output span). After kDamp runs the step towards the new estimate shrinks (1/2, 1/3, …): a
+/// selection that flips between two sample sets then settles between them. Returns the last
+/// model; `rep` gets passes and convergence.
 PerSide<SwitchSide> iterate_switching(const EstimatorConfig& mc0, const RecordColumns& rec,
                                       PerSide<SwitchSide> model, const DataTraits& d,
                                       std::span<const std::size_t> gap_rows, YEdits edits, SwitchingReport& rep) {
@@ -85,7 +86,6 @@ PerSide<SwitchSide> iterate_switching(const EstimatorConfig& mc0, const RecordCo
       SwitchSide q = raw_switch_side(est, s);
       // an edge across zero or a negative d: the nearest physical value (a start far off gives
       // such a first estimate; the next runs move on from it)
-
       if (!verdict_rules::physical_edge(q.c, s)) q.c = 0.0;
       q.d = std::max(q.d, 0.0);
       q.a1 = std::clamp(q.a1, -kMaxPole, kMaxPole);  // an integrator-like first estimate: the slowest stable lag
@@ -458,6 +458,7 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, const RecordColumns& rec, con
       std::optional<EstimationRun> best;
       PerSide<SwitchSide> best_model{};
       for (const double lag : {10.0, 100.0, 30.0, 300.0}) {
+        if (out.switching.passes >= kSwitchBudget) break;  // a long record: at most 80 + 40 runs
         SwitchingReport rep;
         mc.switch_model =
             iterate_switching(mc, rec, switching_start(direct.report, d, lag), d, o.gap_rows, edits, rep);
