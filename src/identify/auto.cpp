@@ -430,16 +430,18 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, const RecordColumns& rec, con
   if (!can_switch) {
     out.run = run_estimator(cfg, rec, ro);
   } else {
-    // First the ẏ switching without what streams or is stored per sample; model switching when it
-    // leaves a side unidentified (or is asked for); the final run again with everything.
+    // First the ẏ switching; model switching when it leaves a side unidentified (or is asked
+    // for). A trace streamed as it goes (on_step) cannot be taken back: then the first runs keep
+    // nothing per sample and the final run is done again with everything.
     const bool forced = cfg.model_switching;
     EstimatorConfig dcfg = cfg;
     dcfg.model_switching = false;
     RunOptions probe = ro;
     probe.keep_trace = probe.keep_outputs = false;
     probe.on_step = nullptr;
-    EstimationRun direct = run_estimator(dcfg, rec, probe);
-    const bool streams = ro.keep_trace || ro.keep_outputs || static_cast<bool>(ro.on_step);
+    const bool streams = static_cast<bool>(ro.on_step);
+    const bool per_sample = streams || ro.keep_trace || ro.keep_outputs;
+    EstimationRun direct = run_estimator(dcfg, rec, streams ? probe : ro);
     bool use_model = false;
     // given guesses are the user's switching: kept (a wrong one is reported as such)
     const bool given = std::isfinite(cfg0.guess_right) || std::isfinite(cfg0.guess_left);
@@ -482,7 +484,7 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, const RecordColumns& rec, con
         cfg = mc;
         RunOptions mro = ro;
         mro.at_end = nullptr;
-        out.run = streams ? run_estimator(mc, rec, mro) : std::move(*best);
+        out.run = per_sample ? run_estimator(mc, rec, mro) : std::move(*best);
       }
     }
     out.switching.used = use_model;
