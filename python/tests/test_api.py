@@ -165,3 +165,10 @@ print("survived")
 """
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert out.returncode == 0 and "survived" in out.stdout, out.stderr
+
+
+def test_online_estimator_refuses_model_switching():
+    # model switching needs a switching model, which only lash.estimate's iteration over a whole
+    # record sets: an online Estimator asked for it is refused, naming the setting
+    with pytest.raises(ValueError, match="model-switching"):
+        lash.Estimator("deadzone-deadband", 0.005, model_switching=True)

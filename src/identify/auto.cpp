@@ -127,8 +127,8 @@ PerSide<SwitchSide> switching_start(const EstimateReport& r, const DataTraits& d
   PerSide<SwitchSide> m;
   for (const Side s : {Side::right, Side::left}) {
     const SideParams& p = (s == Side::right ? r.right : r.left).params;
-    if (p.identified && std::isfinite(p.c) && std::isfinite(p.d))
-      m[s] = {p.a1, p.b1, p.c, std::max(p.d, 0.0)};
+    if (const SwitchSide q{p.a1, p.b1, p.c, std::max(p.d, 0.0)}; p.identified && q.usable())
+      m[s] = q;
     else
       m[s] = {a1, (1.0 + a1) * k, 0.3 * (s == Side::right ? std::max(d.v_hi, 0.0) : std::min(d.v_lo, 0.0)), 0.0};
   }
@@ -404,6 +404,9 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, const RecordColumns& rec, con
   const YEdits edits{edit_rows, edit_values};
   out.cfg = cfg0;
   EstimatorConfig& cfg = out.cfg;
+  // model switching asked for: the ẏ switching's runs (the guess search, the first run) come first
+  const bool forced = cfg.model == ModelKind::deadzone_deadband && cfg.model_switching;
+  cfg.model_switching = false;
   const bool search_r = uses_guesses(cfg.model) && std::isinf(cfg.guess_right);
   const bool search_l = uses_guesses(cfg.model) && std::isinf(cfg.guess_left);
   if (search_r || search_l) {
@@ -433,9 +436,7 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, const RecordColumns& rec, con
     // First the ẏ switching; model switching when it leaves a side unidentified (or is asked
     // for). A trace streamed as it goes (on_step) cannot be taken back: then the first runs keep
     // nothing per sample and the final run is done again with everything.
-    const bool forced = cfg.model_switching;
-    EstimatorConfig dcfg = cfg;
-    dcfg.model_switching = false;
+    const EstimatorConfig dcfg = cfg;
     RunOptions probe = ro;
     probe.keep_trace = probe.keep_outputs = false;
     probe.on_step = nullptr;

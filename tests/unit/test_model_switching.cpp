@@ -6,6 +6,8 @@
 
 #include <cmath>
 #include <random>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "lash/blocks/deadband.hpp"
@@ -71,18 +73,24 @@ TEST(ModelSwitching, TheTruePlantAsSwitchingModelGivesThePlantExactly) {
   }
 }
 
-TEST(ModelSwitching, WithoutAUsableSwitchingModelNothingUpdates) {
-  std::vector<double> v, y;
-  record(Plant{}, v, y);
+TEST(ModelSwitching, WithoutAUsableSwitchingModelTheEstimatorIsRefused) {
+  // an estimator that could never update must not pass for one that has not updated yet
   EstimatorConfig cfg(ModelKind::deadzone_deadband, 0.005);
   cfg.model_switching = true;
   cfg.noise = NoiseSettings{};
   cfg.switch_model.right = {-0.97, 0.05, 220.0, 35.0};  // left unset (NaN)
-  DeadzoneDeadbandEstimator est(cfg);
-  for (std::size_t k = 0; k < v.size(); ++k) est.step(v[k], y[k]);
-  EXPECT_EQ(est.updates(Side::right), 0u);
-  EXPECT_EQ(est.updates(Side::left), 0u);
-  EXPECT_FALSE(est.params(Side::right).identified);
+  try {
+    DeadzoneDeadbandEstimator est(cfg);
+    FAIL() << "constructed";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("model-switching"), std::string::npos) << e.what();
+  }
+  cfg.switch_model.left = {-0.97, 0.05, -150.0, -1.0};  // a negative d
+  EXPECT_THROW(DeadzoneDeadbandEstimator{cfg}, std::invalid_argument);
+  cfg.switch_model.left = {-1.0, 0.05, -150.0, 20.0};  // not stable
+  EXPECT_THROW(DeadzoneDeadbandEstimator{cfg}, std::invalid_argument);
+  cfg.switch_model.left = {-0.97, 0.05, -150.0, 20.0};
+  EXPECT_NO_THROW(DeadzoneDeadbandEstimator{cfg});
 }
 
 TEST(ModelSwitching, ConfigIsChecked) {

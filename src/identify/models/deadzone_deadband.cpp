@@ -1,6 +1,7 @@
 #include "lash/identify/models/deadzone_deadband.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 #include <vector>
 
 #include "lash/identify/auto.hpp"
@@ -54,12 +55,17 @@ DeadzoneDeadbandModel::DeadzoneDeadbandModel(const EstimatorConfig& cfg)
       pooled_{Rls<4>(cfg.rls4()), Rls<4>(cfg.rls4())},
       pooled_mode_(cfg.pooled) {
   sc_ = {cfg.guess_right, cfg.guess_left};
-  if (cfg.model_switching)  // the free run starts from the switching model
-    for (const Side sd : {Side::right, Side::left})
-      if (const auto& m = cfg.switch_model[sd]; m.usable()) {
-        sc_[sd] = m.c;
-        sim_[sd] = {m.a1, m.b1, m.d};
-      }
+  if (!cfg.model_switching) return;
+  // an estimator that could never update must not pass for one that has not updated yet
+  if (!cfg.switch_model.right.usable() || !cfg.switch_model.left.usable())
+    throw std::invalid_argument(
+        "model-switching: needs a switching model for both sides (a1, b1, c, d); lash estimate iterates it over a "
+        "whole record (docs/method.md §A4.4b), an online estimator has none");
+  for (const Side sd : {Side::right, Side::left}) {  // the free run starts from the switching model
+    const auto& m = cfg.switch_model[sd];
+    sc_[sd] = m.c;
+    sim_[sd] = {m.a1, m.b1, m.d};
+  }
 }
 
 // predict_free() and free_run() run on every sample: defined before update() and inlined into
