@@ -75,7 +75,7 @@ struct GuessReport {
   double edge = 0.0;           ///< the edge the check used [v unit] (NaN: none)
 };
 
-/// What model switching (docs/method.md §A4.4) did in estimate_auto.
+/// What model switching (docs/method.md §A4.4b) did in estimate_auto.
 struct SwitchingReport {
   bool tried = false;      ///< the iteration ran (deadzone-deadband, pooled)
   bool used = false;       ///< the final run switched on the model (else on ẏ and the guesses)

@@ -147,7 +147,7 @@ struct DeadzoneDeadbandSettings {
   double settle_tol = 0.01;
   std::uint32_t settle_updates = 5;
   double singular_tol = 1e-6;  ///< eq. 31/32: |det| below tol·(|a|+|b|) terms counts as singular
-  /// Model switching (docs/method.md §A4.4, "Model switching"): the side, the direction and the
+  /// Model switching (docs/method.md §A4.4b): the side, the direction and the
   /// instrument of each update come from a switching model (below) driven by v alone, instead of
   /// ẏ and the guesses; pooled only. `lash estimate` iterates it by itself when the ẏ switching
   /// leaves a side unidentified; true makes it iterate on every record.

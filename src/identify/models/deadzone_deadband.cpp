@@ -135,11 +135,11 @@ DeadzoneDeadbandModel::DeadzoneDeadbandModel(const EstimatorConfig& cfg)
 }
 
 double DeadzoneDeadbandModel::update_switched(EstimatorCore& c, const Conditioned& s, bool warming) noexcept {
-  // docs/method.md §A4.4 "Model switching": the switching model (a1, b1, c, d per side, fixed
-  // through the run) is driven by v alone. Its deadband says when the output is pushed up or
-  // down; its edges say which side's regression a sample belongs to, beyond the edge
-  // (φ = [−y(k−1), v(k−1), 1, ∓1]) or inside the deadzone on that side of zero (u = 0:
-  // φ = [−y(k−1), 0, 0, ∓1]); its output ŷ(k−1) is the instrument for y(k−1).
+  // docs/method.md §A4.4b: the switching model (a1, b1, c, d per side, fixed through the run,
+  // usable on both sides: the constructor checked) is driven by v alone. Its deadband says when
+  // the output is pushed up or down; its edges say which side's regression a sample belongs to,
+  // beyond the edge (φ = [−y(k−1), v(k−1), 1, ∓1]) or inside the deadzone on that side of zero
+  // (u = 0: φ = [−y(k−1), 0, 0, ∓1]); its output ŷ(k−1) is the instrument for y(k−1).
   const PerSide<EstimatorConfig::SwitchSide>& m = c.cfg.switch_model;
   const double v1 = c.v1, y1 = c.y1;
   if (!sw_.started) {  // the first sample (or the first after a gap): the model starts at rest at y
@@ -148,7 +148,6 @@ double DeadzoneDeadbandModel::update_switched(EstimatorCore& c, const Conditione
     sw_.started = true;
     return predict_free(c, last_, y1, v1);
   }
-  if (!m.right.usable() || !m.left.usable()) return predict_free(c, last_, y1, v1);
   const double z0 = -sw_.y;  // the model's y(k−1)
   const Side zs = v1 > m.right.c ? Side::right : (v1 < m.left.c ? Side::left : sw_.last);
   sw_.last = zs;

@@ -53,7 +53,7 @@ class DeadzoneDeadbandModel {
   };
   Derived derive(const EstimatorCore& core, Side s) const noexcept;
   double update(EstimatorCore& c, const Conditioned& s, bool warming) noexcept;
-  /// update() under model switching (EstimatorConfig::model_switching, docs/method.md §A4.4).
+  /// update() under model switching (EstimatorConfig::model_switching, docs/method.md §A4.4b).
   double update_switched(EstimatorCore& c, const Conditioned& s, bool warming) noexcept;
   void free_run(EstimatorCore& c) noexcept;
   verdict_rules::Evidence evidence(const EstimatorCore& c, Side s) const noexcept;
