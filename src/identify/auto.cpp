@@ -49,12 +49,10 @@ struct Streams {
 using SwitchSide = EstimatorConfig::SwitchSide;
 constexpr int kSwitchBudget = 80;  // runs after which no further start is tried
 
-/// A side's raw estimate of a model-switched run: η = [a1, b1, −b1·c, d(1 + a1)].
+/// A side's raw estimate of a model-switched run (no estimate: a default SwitchSide, not usable).
 SwitchSide raw_switch_side(const AnyEstimator& est, Side s) {
   const auto* e = est.get<DeadzoneDeadbandEstimator>();
-  if (!e) return {};
-  const auto& eta = e->pooled_rls(s).eta();
-  return {eta[0], eta[1], -eta[2] / eta[1], eta[3] / (1.0 + eta[0])};
+  return e ? e->pooled_params(s) : SwitchSide{};
 }
 
 /// The model-switching iteration (docs/method.md §A4.4b): each run's switching model is the
@@ -435,13 +433,13 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, const RecordColumns& rec, con
   } else {
     // First the ẏ switching; model switching when it leaves a side unidentified (or is asked
     // for). A trace streamed as it goes (on_step) cannot be taken back: then the first runs keep
-    // nothing per sample and the final run is done again with everything.
+    // nothing per sample and the final run is done again with everything; kept outputs and
+    // traces are kept by every run and the adopted one is used as it is.
     const EstimatorConfig dcfg = cfg;
     RunOptions probe = ro;
     probe.keep_trace = probe.keep_outputs = false;
     probe.on_step = nullptr;
     const bool streams = static_cast<bool>(ro.on_step);
-    const bool per_sample = streams || ro.keep_trace || ro.keep_outputs;
     EstimationRun direct = run_estimator(dcfg, rec, streams ? probe : ro);
     bool use_model = false;
     // given guesses are the user's switching: kept (a wrong one is reported as such)
@@ -469,8 +467,8 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, const RecordColumns& rec, con
         ++out.switching.starts;
         if (!rep.converged) continue;
         out.switching.converged = true;
-        RunOptions mro = probe;
-        mro.at_end = nullptr;  // its edges are not guesses' evidence
+        RunOptions mro = streams ? probe : ro;  // kept outputs are kept here: no rerun if adopted
+        mro.at_end = nullptr;                   // its edges are not guesses' evidence
         EstimationRun m = run_estimator(mc, rec, mro);
         if (!best || sides_identified(m.report) > sides_identified(best->report)) {
           best = std::move(m);
@@ -485,7 +483,7 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, const RecordColumns& rec, con
         cfg = mc;
         RunOptions mro = ro;
         mro.at_end = nullptr;
-        out.run = per_sample ? run_estimator(mc, rec, mro) : std::move(*best);
+        out.run = streams ? run_estimator(mc, rec, mro) : std::move(*best);
       }
     }
     out.switching.used = use_model;

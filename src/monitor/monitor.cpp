@@ -407,7 +407,12 @@ void check_settings(const MonitorSettings& s) {
   } catch (const std::invalid_argument& e) {
     throw InputError("", 0, "reguess", e.what());
   }
-  resolve_settings(s.estimator);
+  // model switching is an offline iteration over a whole record (docs/method.md §A4.4b): the
+  // window estimate runs it, the online estimator has no switching model to run with
+  if (resolve_settings(s.estimator).cfg.model_switching && s.mode == EstimateMode::online)
+    throw InputError("", 0, "model-switching",
+                     "needs --estimate window: model switching iterates over a whole window, the online "
+                     "estimator cannot");
   (void)make_map(s);
 }
 

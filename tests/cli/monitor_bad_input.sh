@@ -23,6 +23,12 @@ expect "--v" -- "$tmp/a.log" --dbc "$DBC" --v Bench --y BenchSensors.PilotPressu
 expect "missing.log" -- "$tmp/missing.log" --dbc "$DBC" --v $V --y BenchSensors.PilotPressure_kPa --model linear
 expect "--model" -- "$tmp/a.log" --dbc "$DBC" --v $V --y BenchSensors.PilotPressure_kPa
 expect "--every" -- "$tmp/a.log" --dbc "$DBC" --v $V --y BenchSensors.PilotPressure_kPa --model linear --every 0
+# model switching iterates over a whole window: refused online (named), run in window mode (the default)
+expect "model-switching" -- "$tmp/a.log" --dbc "$DBC" --v $V --y BenchSensors.PilotPressure_kPa --model deadzone-deadband --model-switching --estimate online
+printf 'model = "deadzone-deadband"\nmodel_switching = true\n' > "$tmp/ms.toml"
+expect "model-switching" -- "$tmp/a.log" --dbc "$DBC" --v $V --y BenchSensors.PilotPressure_kPa --config "$tmp/ms.toml" --estimate online
+"$L" monitor "$tmp/a.log" --dbc "$DBC" --v $V --y BenchSensors.PilotPressure_kPa --config "$tmp/ms.toml" > "$tmp/out" 2> "$tmp/err" ||
+  { echo "FAIL: --estimate window with model_switching -> rc $?, stderr: $(cat "$tmp/err")"; fail=1; }
 printf '[alarms]\nq_r_max = 3\n' > "$tmp/bad.toml"
 expect "q_r_max" -- "$tmp/a.log" --dbc "$DBC" --v $V --y BenchSensors.PilotPressure_kPa --model linear --config "$tmp/bad.toml"
 expect "missing.sqlite" -- --report "$tmp/missing.sqlite" -o "$tmp/x.png"

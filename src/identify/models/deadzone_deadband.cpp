@@ -202,13 +202,12 @@ DeadzoneDeadbandModel::Derived DeadzoneDeadbandModel::derive(const EstimatorCore
               (!cfg.model_switching || beyond_[side] >= cfg.min_updates);  // b1 and c need samples beyond the edge
   if (cfg.pooled) {
     // η = [a1, b1, e0, g] with e± = e0 ∓ g, e0 = −b1·c, g = d(1 + a1)
-    const auto& e = pooled_[side].eta();
-    q.a1 = e[0];
-    q.b1 = e[1];
-    const double den = 1.0 + q.a1;
-    q.solvable = std::fabs(den) > cfg.singular_tol && std::fabs(q.b1) > 1e-12;
-    q.c = -e[2] / q.b1;
-    q.d = e[3] / den;
+    const EstimatorConfig::SwitchSide r = pooled_params(side);
+    q.a1 = r.a1;
+    q.b1 = r.b1;
+    q.solvable = std::fabs(1.0 + q.a1) > cfg.singular_tol && std::fabs(q.b1) > 1e-12;
+    q.c = r.c;
+    q.d = r.d;
   } else {
     const auto& ep = rls_[key(side, true)].eta();
     const auto& em = rls_[key(side, false)].eta();

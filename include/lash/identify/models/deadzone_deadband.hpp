@@ -31,6 +31,13 @@ class DeadzoneDeadbandModel {
   const Rls<3>& rls(Key k) const noexcept { return rls_[k]; }
   /// The 4-parameter regression of one side (pooled mode).
   const Rls<4>& pooled_rls(Side s) const noexcept { return pooled_[s]; }
+  /// Pooled mode: side s's raw estimate, η = [a1, b1, −b1·c, d(1 + a1)] solved for (a1, b1, c, d)
+  /// without checks (c or d is ±inf or NaN when b1 or 1 + a1 is 0). The verdict's checks are in
+  /// derive().
+  EstimatorConfig::SwitchSide pooled_params(Side s) const noexcept {
+    const auto& e = pooled_[s].eta();
+    return {e[0], e[1], -e[2] / e[1], e[3] / (1.0 + e[0])};
+  }
   /// Pooled mode: c = −e0/b1 of side s's raw estimate; NaN when b1 ≈ 0 and in separate-RLS mode
   /// (there c needs both keys: params()).
   double edge(Side s) const noexcept {
