@@ -68,14 +68,18 @@ def run_one(lash, kind, seed, d, duration=150.0, amp=500.0):
     j = json.loads(e.stdout)
     truth = {"right": dict(a1=p["a1"], b1=p["b1"], c=p["cr"], d=p["dr"]),
              "left": dict(a1=p["a1"], b1=p["b1"], c=p["cl"], d=p["dl"])}
-    errs, ident = {}, True
+    errs, ident, cover = {}, True, {}
     for side in ("right", "left"):
         ident = ident and j[side]["identified"]
         for k, want in truth[side].items():
             got = j[side][k]
             errs[f"{k}_{side[0]}"] = float("inf") if got is None else abs(got / want - 1)
+            # an identified side's 95 % interval: does it hold the truth? (None: no interval)
+            ci = j[side]["ci95"].get(k) if j[side]["identified"] else None
+            cover[f"{k}_{side[0]}"] = None if ci is None else bool(ci[0] <= want <= ci[1])
     return dict(kind=kind, seed=seed, identified=ident, errs=errs, plant=p, sigma=sigma,
-                switching=j.get("model_switching"))
+                switching=j.get("model_switching"), cover=cover,
+                sides_identified=sum(bool(j[s]["identified"]) for s in ("right", "left")))
 
 
 def main():

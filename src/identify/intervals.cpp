@@ -75,6 +75,7 @@ PerSide<SideIntervals> batch_means_intervals(const EstimatorConfig& cfg, const R
                                              const PerSide<SideParams>& estimate, const IntervalSettings& s) {
   const std::size_t n = rec.size(), B = s.sections;
   if (B < 2 || n / B < 2) return {};
+  if (cfg.model_switching && cfg.rls.lambda == 1.0) return jackknife_intervals(cfg, rec, estimate, s);
   const std::size_t len = n / B;
   // Each section's estimator starts fresh. Sections b and b + half run in lockstep in one loop:
   // two independent recursions (each RLS update waits on its own last result) that the CPU
@@ -129,16 +130,18 @@ PerSide<SideIntervals> batch_means_intervals(const EstimatorConfig& cfg, const R
   return section_intervals(cfg, at, len, n, estimate, s.min_sections);
 }
 
-PerSide<SideIntervals> section_intervals(const EstimatorConfig& cfg, std::span<const PerSide<SideParams>> sections,
-                                         std::size_t len, std::size_t n, const PerSide<SideParams>& estimate,
-                                         std::size_t min_sections) {
+namespace {
+/// The intervals from per-side replicate estimates (sections or jackknife replicates: those of
+/// identified sides) with half-width t_{0.975, m−1} · sd · scale, m the replicates used.
+PerSide<SideIntervals> replicate_intervals(const EstimatorConfig& cfg, std::span<const PerSide<SideParams>> reps,
+                                           const PerSide<SideParams>& estimate, double scale, std::size_t min_n) {
   PerSide<SideIntervals> out;
-  // per side, per parameter: the section estimates of identified sides
+  // per side, per parameter: the replicate estimates of identified sides
   struct Samples {
     std::vector<double> a1, b1, c, d, K, tau;
   };
   PerSide<Samples> sm;
-  for (const PerSide<SideParams>& sec : sections) {
+  for (const PerSide<SideParams>& sec : reps) {
     for (Side side : {Side::right, Side::left}) {
       const SideParams& p = sec[side];
       if (!p.identified) continue;
@@ -152,20 +155,46 @@ PerSide<SideIntervals> section_intervals(const EstimatorConfig& cfg, std::span<c
       if (std::isfinite(tau)) q.tau.push_back(tau);
     }
   }
-  const double scale = std::sqrt(memory(cfg, len) / memory(cfg, n));
   for (Side side : {Side::right, Side::left}) {
     const SideParams& e = estimate[side];
     const Samples& q = sm[side];
     SideIntervals& r = out[side];
-    const std::size_t m = min_sections;
-    r.a1 = around(e.a1, q.a1, scale, m);
-    r.b1 = around(e.b1, q.b1, scale, m);
-    r.c = around(e.c, q.c, scale, m);
-    r.d = around(e.d, q.d, scale, m);
-    r.K = around(static_gain(e.a1, e.b1), q.K, scale, m);
-    r.tau_s = around(time_constant_s(e.a1, cfg.dt_s), q.tau, scale, m);
+    r.a1 = around(e.a1, q.a1, scale, min_n);
+    r.b1 = around(e.b1, q.b1, scale, min_n);
+    r.c = around(e.c, q.c, scale, min_n);
+    r.d = around(e.d, q.d, scale, min_n);
+    r.K = around(static_gain(e.a1, e.b1), q.K, scale, min_n);
+    r.tau_s = around(time_constant_s(e.a1, cfg.dt_s), q.tau, scale, min_n);
   }
   return out;
+}
+}  // namespace
+
+PerSide<SideIntervals> section_intervals(const EstimatorConfig& cfg, std::span<const PerSide<SideParams>> sections,
+                                         std::size_t len, std::size_t n, const PerSide<SideParams>& estimate,
+                                         std::size_t min_sections) {
+  return replicate_intervals(cfg, sections, estimate, std::sqrt(memory(cfg, len) / memory(cfg, n)), min_sections);
+}
+
+PerSide<SideIntervals> jackknife_intervals(const EstimatorConfig& cfg, const RecordColumns& rec,
+                                           const PerSide<SideParams>& estimate, const IntervalSettings& s) {
+  const std::size_t n = rec.size(), B = s.sections;
+  if (B < 2 || n / B < 2) return {};
+  const std::size_t len = n / B;
+  std::vector<PerSide<SideParams>> reps(B);
+  AnyEstimator e(cfg);
+  const auto none = [](std::size_t, double, const auto&) {};
+  for (std::size_t b = 0; b < B; ++b) {  // replicate b: the record without group b (the last: to the end)
+    const std::size_t g0 = b * len, g1 = b + 1 == B ? n : g0 + len;
+    e.reset();
+    step_through(e, rec, 0, g0, s.gap_rows, none);
+    e.restart();  // the samples on both sides of the group are not neighbours
+    step_through(e, rec, g1, n, s.gap_rows, none);
+    reps[b] = {e.params(Side::right), e.params(Side::left)};
+  }
+  // var = (B − 1)/B · Σ(θ_(b) − θ̄)² = sd² · (B − 1)²/B: sd · (B − 1)/√B; every replicate is needed
+  const double fb = static_cast<double>(B);
+  return replicate_intervals(cfg, reps, estimate, (fb - 1.0) / std::sqrt(fb), B);
 }
 
 }  // namespace lash

@@ -6,7 +6,8 @@ DZ -> G -> DB plant (edges 80-300, half-widths 5-50, tau 0.05-0.5 s, K 0.5-3) wi
 identified with a1 within 1 %, b1 3 %, c 3 %, d 10 % (issue 30's bounds). Floors: what model
 switching reaches today. Before it, the dy/dt switching identified no multisine run and 5 step
 runs, 2 of them within the bounds. The issue's "every seed" is not reached
-(docs/identification.md, "Inputs that are not sines")."""
+(docs/identification.md, "Inputs that are not sines"). Item 3: the coverage of the identified
+sides' 95 % intervals over the same runs."""
 import json, os, subprocess, sys, tempfile
 
 SRC = os.environ["LASH_SOURCE_DIR"]
@@ -38,15 +39,29 @@ with tempfile.TemporaryDirectory() as d:
         check(p.returncode == 2 and "model-switching" in p.stderr, f"--model-switching {extra}: exit {p.returncode}: "
               f"{p.stderr.strip()}")
 FLOOR = {"multisine": 13, "steps": 17}
+covered = {k: [0, 0] for k in TOL}  # per parameter: truth inside the 95 % interval, intervals
+sides = with_ci = 0
 with tempfile.TemporaryDirectory() as d:
     for kind, floor in FLOOR.items():
         good = 0
         for seed in range(1, 21):
             r = run_one(LASH, kind, seed, d)
+            sides += r["sides_identified"]
+            with_ci += sum(r["cover"][f"a1_{s}"] is not None for s in "rl")
+            for key, inside in r["cover"].items():
+                if inside is not None:
+                    covered[key.split("_")[0]][0] += inside
+                    covered[key.split("_")[0]][1] += 1
             ok = r["identified"] and all(r["errs"][f"{k}_{s}"] <= TOL[k] for k in TOL for s in "rl")
             good += ok
             print(f"{kind} seed {seed}: {'within' if ok else 'not within'} the bounds; "
                   + " ".join(f"{k} {100 * v:.2f}%" for k, v in r["errs"].items()))
         print(("ok   " if good >= floor else "FAIL ") + f"{kind}: {good} of 20 runs within the bounds (floor {floor})")
         fail |= good < floor
+# Issue 30 item 3: the 95 % intervals of the identified sides hold the truth at least 90 % of the
+# time, per parameter (model switching's are jackknife intervals, docs/identification.md); and
+# most identified sides have one (measured: 64 of 76; before the jackknife, 37)
+for k, (inside, n) in covered.items():
+    check(n > 0 and inside >= 0.90 * n, f"{k}: the truth inside {inside} of {n} 95 % intervals (>= 90 %)")
+check(with_ci >= 60, f"{with_ci} of {sides} identified sides have 95 % intervals (floor 60)")
 sys.exit(fail)

@@ -14,6 +14,7 @@
 #include "lash/blocks/deadzone.hpp"
 #include "lash/blocks/first_order.hpp"
 #include "lash/identify/estimators.hpp"
+#include "lash/identify/intervals.hpp"
 
 namespace lash {
 namespace {
@@ -91,6 +92,67 @@ TEST(ModelSwitching, WithoutAUsableSwitchingModelTheEstimatorIsRefused) {
   EXPECT_THROW(DeadzoneDeadbandEstimator{cfg}, std::invalid_argument);
   cfg.switch_model.left = {-0.97, 0.05, -150.0, 20.0};
   EXPECT_NO_THROW(DeadzoneDeadbandEstimator{cfg});
+}
+
+TEST(ModelSwitching, IntervalsAreTheDeleteAGroupJackknife) {
+  // batch_means_intervals under model switching with lambda = 1: the jackknife of intervals.hpp,
+  // recomputed here from its definition. Replicate b is a separate record (the samples without
+  // group b, made here) run from the start, restarted where the group was cut out; the interval
+  // is theta +- t_{0.975,9} sqrt((B - 1)/B sum (theta_b - mean)^2), t from scipy.stats.t.ppf.
+  const Plant p;
+  std::vector<double> v, y;
+  record(p, v, y);
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> noise(0.0, 2.0);
+  for (double& x : y) x += noise(rng);
+  EstimatorConfig cfg(ModelKind::deadzone_deadband, 0.005);
+  cfg.model_switching = true;
+  cfg.method = EstimationMethod::iv;
+  cfg.noise = NoiseSettings{};
+  cfg.rls.lambda = 1.0;
+  cfg.switch_model.right = {p.a1, p.b1, p.cr, p.dr};
+  cfg.switch_model.left = {p.a1, p.b1, p.cl, p.dl};
+  const auto run = [&](const std::vector<double>& vv, const std::vector<double>& yy, std::size_t join) {
+    DeadzoneDeadbandEstimator est(cfg);
+    for (std::size_t k = 0; k < vv.size(); ++k) {
+      if (k == join) est.restart();
+      est.step(vv[k], yy[k]);
+    }
+    return PerSide<SideParams>{est.params(Side::right), est.params(Side::left)};
+  };
+  const PerSide<SideParams> whole = run(v, y, v.size());
+  const PerSide<SideIntervals> ci = batch_means_intervals(cfg, v, y, whole);
+  constexpr std::size_t B = 10;
+  const std::size_t n = v.size(), len = n / B;
+  std::vector<PerSide<SideParams>> rep;
+  for (std::size_t b = 0; b < B; ++b) {
+    const std::size_t g0 = b * len, g1 = b + 1 == B ? n : g0 + len;
+    std::vector<double> vb(v.begin(), v.begin() + static_cast<long>(g0)), yb(y.begin(), y.begin() + static_cast<long>(g0));
+    vb.insert(vb.end(), v.begin() + static_cast<long>(g1), v.end());
+    yb.insert(yb.end(), y.begin() + static_cast<long>(g1), y.end());
+    rep.push_back(run(vb, yb, g0));
+  }
+  constexpr double t975_9 = 2.2621571627409915;  // scipy.stats.t.ppf(0.975, 9)
+  for (const Side s : {Side::right, Side::left}) {
+    ASSERT_TRUE(whole[s].identified);
+    const auto check = [&](double centre, const Interval& iv, double SideParams::*f) {
+      double mean = 0.0, ss = 0.0;
+      for (const auto& r : rep) {
+        ASSERT_TRUE(r[s].identified);
+        mean += r[s].*f / B;
+      }
+      for (const auto& r : rep) ss += (r[s].*f - mean) * (r[s].*f - mean);
+      const double half = t975_9 * std::sqrt((B - 1.0) / B * ss);
+      ASSERT_TRUE(iv.valid());
+      EXPECT_GT(half, 0.0);
+      EXPECT_NEAR(iv.lo, centre - half, 1e-8 * half);  // student_t975 holds t to 9 digits
+      EXPECT_NEAR(iv.hi, centre + half, 1e-8 * half);
+    };
+    check(whole[s].a1, ci[s].a1, &SideParams::a1);
+    check(whole[s].b1, ci[s].b1, &SideParams::b1);
+    check(whole[s].c, ci[s].c, &SideParams::c);
+    check(whole[s].d, ci[s].d, &SideParams::d);
+  }
 }
 
 TEST(ModelSwitching, ConfigIsChecked) {
