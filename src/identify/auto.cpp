@@ -1,5 +1,7 @@
 #include "lash/identify/auto.hpp"
 
+#include "lash/identify/intervals.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cstdlib>
@@ -444,7 +446,24 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, const RecordColumns& rec, con
     bool use_model = false;
     // given guesses are the user's switching: kept (a wrong one is reported as such)
     const bool given = std::isfinite(cfg0.guess_right) || std::isfinite(cfg0.guess_left);
-    if (forced || (!given && sides_identified(direct.report) < 2)) {
+    // both sides identified by the ẏ switching but not reproduced by batch means (fewer than 5 of
+    // 10 sections identify a side: no interval): the estimate rests on few selected samples,
+    // where the ẏ selection's bias shows (§A4.4b); model switching checks it
+    std::optional<PerSide<SideIntervals>> direct_ci;  // kept: the report's intervals when the ẏ result stays
+    const auto unconfirmed = [&] {
+      IntervalSettings is;
+      is.gap_rows = o.gap_rows;
+      direct_ci = batch_means_intervals(dcfg, rec, {direct.report.right.params, direct.report.left.params}, is);
+      return !(direct_ci->right.a1.valid() && direct_ci->left.a1.valid());
+    };
+    const int direct_sides = sides_identified(direct.report);
+    const char* trigger = forced                                   ? "asked"
+                          : given                                  ? nullptr
+                          : direct_sides < 2                       ? "side_open"
+                          : unconfirmed()                          ? "no_interval"
+                                                                   : nullptr;
+    if (trigger) {
+      out.switching.trigger = trigger;
       const DataTraits d = edit_rows.empty() && o.traits && o.traits->dt_s == cfg.dt_s
                                ? *o.traits
                                : analyse_record(rec, cfg.dt_s, edits);
@@ -477,7 +496,9 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, const RecordColumns& rec, con
         if (sides_identified(best->report) == 2) break;
       }
       out.switching.tried = true;
-      use_model = best && (forced || sides_identified(best->report) > sides_identified(direct.report));
+      // adopted: asked for; identifies more sides; or, checking an unconfirmed ẏ result, identifies both
+      use_model = best && (forced || sides_identified(best->report) > direct_sides ||
+                           (out.switching.trigger == "no_interval" && sides_identified(best->report) == 2));
       if (use_model) {
         mc.switch_model = best_model;
         cfg = mc;
@@ -488,6 +509,7 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, const RecordColumns& rec, con
     }
     out.switching.used = use_model;
     if (!use_model) {
+      out.ci95 = direct_ci;
       cfg = dcfg;
       out.run = streams ? run_estimator(dcfg, rec, ro) : std::move(direct);
     }

@@ -139,7 +139,10 @@ ArrayEstimate estimate_record(const SettingsSources& src, const RecordColumns& r
   out.run = estimate_auto(set.cfg, rec, ao);
   out.estimator_cpu_s = thread_cpu_s() - cpu_start;
   out.estimator_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
-  if (o.intervals) add_intervals(out.run.run, out.run.cfg, rec, smp.gap_rows);
+  if (o.intervals && out.run.ci95)  // computed while checking the ẏ result: the same estimate, settings, record
+    attach_intervals(out.run.run.report, *out.run.ci95);
+  else if (o.intervals)
+    add_intervals(out.run.run, out.run.cfg, rec, smp.gap_rows);
   scored.report = out.run.run.report;
   scored.nrmse = out.run.run.score.value();
   out.result = std::move(scored);

@@ -257,7 +257,8 @@ std::string estimate_auto_json(const AutoRun& ar, Preset preset, const ReportFit
     Json sw{{"used", ar.switching.used},
             {"converged", ar.switching.converged},
             {"passes", ar.switching.passes},
-            {"starts", ar.switching.starts}};
+            {"starts", ar.switching.starts},
+            {"trigger", ar.switching.trigger}};
     if (ar.switching.used)
       for (const auto& [name, sd] : {std::pair{"right", &m.right}, std::pair{"left", &m.left}})
         sw["model"][name] = {{"a1", num(sd->a1)}, {"b1", num(sd->b1)}, {"c", num(sd->c)}, {"d", num(sd->d)}};
@@ -282,9 +283,12 @@ std::string estimate_auto_text(const AutoRun& ar, double dt_s, const ReportFit& 
   }
   if (ar.outliers > 0) out += fmt::format("outliers: {} samples of y replaced by the outlier gate\n", ar.outliers);
   if (ar.switching.tried)
-    out += fmt::format("model switching: {} after {} runs ({}){}\n", ar.switching.used ? "used" : "not used",
+    out += fmt::format("model switching: {} after {} runs ({}){}{}\n", ar.switching.used ? "used" : "not used",
                        ar.switching.passes, ar.switching.converged ? "converged" : "did not converge",
-                       ar.switching.used ? "" : "; the result is the dy/dt switching's");
+                       ar.switching.used ? "" : "; the result is the dy/dt switching's",
+                       ar.switching.trigger == "no_interval"
+                           ? "; tried because the dy/dt switching's estimate had no 95 % interval"
+                           : "");
   return out;
 }
 

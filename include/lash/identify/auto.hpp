@@ -12,6 +12,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <vector>
 #include <span>
 #include <string>
@@ -19,6 +20,7 @@
 
 #include "lash/identify/any_estimator.hpp"
 #include "lash/identify/config.hpp"
+#include "lash/identify/intervals.hpp"
 
 namespace lash {
 
@@ -82,6 +84,10 @@ struct SwitchingReport {
   bool converged = false;  ///< the switching model stopped moving (within the tolerance)
   int passes = 0;          ///< runs over the record the iterations took (all starts)
   int starts = 0;          ///< starting models tried (lags of 10, 100, 30, 300 samples)
+  /// why it ran: "asked" (--model-switching), "side_open" (the ẏ switching left a side
+  /// unidentified), "no_interval" (it identified both, but batch means' sections could not give a
+  /// side an interval: an estimate that rests on few samples, docs/method.md §A4.4b)
+  std::string trigger;
 };
 struct AutoRun {
   EstimatorConfig cfg;         ///< the settings of the final run (what --print-config writes)
@@ -89,6 +95,9 @@ struct AutoRun {
   EstimationRun run;
   GuessReport right, left;
   std::uint64_t outliers = 0;  ///< samples of y the outlier gate replaced (auto_gate.hpp)
+  /// The batch-means intervals of the final run's estimate when estimate_auto computed them
+  /// already (the check of a ẏ result, SwitchingReport::trigger): add_intervals need not run again.
+  std::optional<PerSide<SideIntervals>> ci95;
 };
 
 struct AutoOptions {
