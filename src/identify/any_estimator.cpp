@@ -156,7 +156,11 @@ void add_intervals(EstimationRun& run, const EstimatorConfig& cfg, const RecordC
                    std::span<const std::size_t> gap_rows) {
   IntervalSettings s;
   s.gap_rows = gap_rows;
-  attach_intervals(run.report, batch_means_intervals(cfg, rec, {run.report.right.params, run.report.left.params}, s));
+  const PerSide<SideParams> est{run.report.right.params, run.report.left.params};
+  // model switching with λ = 1: its sides are often driven beyond the edge too seldom for a
+  // section's estimate, and the estimate is a smooth function of sums over the samples
+  attach_intervals(run.report, cfg.model_switching && cfg.rls.lambda == 1.0 ? jackknife_intervals(cfg, rec, est, s)
+                                                                             : batch_means_intervals(cfg, rec, est, s));
 }
 
 void add_intervals(EstimationRun& run, const EstimatorConfig& cfg, std::span<const double> v,

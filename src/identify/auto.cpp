@@ -1,7 +1,5 @@
 #include "lash/identify/auto.hpp"
 
-#include "lash/identify/intervals.hpp"
-
 #include <algorithm>
 #include <array>
 #include <cstdlib>

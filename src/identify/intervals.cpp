@@ -62,6 +62,10 @@ Interval around(double centre, const std::vector<double>& xs, double scale, std:
   iv.hi = centre + half;
   return iv;
 }
+
+/// The length of each of B consecutive groups (sections) of n samples; 0 when there are too few
+/// groups or samples for an interval.
+std::size_t group_len(std::size_t n, std::size_t B) { return B < 2 || n / B < 2 ? 0 : n / B; }
 }  // namespace
 
 PerSide<SideIntervals> batch_means_intervals(const EstimatorConfig& cfg, std::span<const double> v,
@@ -73,10 +77,8 @@ PerSide<SideIntervals> batch_means_intervals(const EstimatorConfig& cfg, std::sp
 
 PerSide<SideIntervals> batch_means_intervals(const EstimatorConfig& cfg, const RecordColumns& rec,
                                              const PerSide<SideParams>& estimate, const IntervalSettings& s) {
-  const std::size_t n = rec.size(), B = s.sections;
-  if (B < 2 || n / B < 2) return {};
-  if (cfg.model_switching && cfg.rls.lambda == 1.0) return jackknife_intervals(cfg, rec, estimate, s);
-  const std::size_t len = n / B;
+  const std::size_t n = rec.size(), B = s.sections, len = group_len(n, B);
+  if (len == 0) return {};
   // Each section's estimator starts fresh. Sections b and b + half run in lockstep in one loop:
   // two independent recursions (each RLS update waits on its own last result) that the CPU
   // overlaps, where one after the other they left it waiting. Same samples, same order per
@@ -178,9 +180,8 @@ PerSide<SideIntervals> section_intervals(const EstimatorConfig& cfg, std::span<c
 
 PerSide<SideIntervals> jackknife_intervals(const EstimatorConfig& cfg, const RecordColumns& rec,
                                            const PerSide<SideParams>& estimate, const IntervalSettings& s) {
-  const std::size_t n = rec.size(), B = s.sections;
-  if (B < 2 || n / B < 2) return {};
-  const std::size_t len = n / B;
+  const std::size_t n = rec.size(), B = s.sections, len = group_len(n, B);
+  if (len == 0) return {};
   std::vector<PerSide<SideParams>> reps(B);
   AnyEstimator e(cfg);
   const auto none = [](std::size_t, double, const auto&) {};

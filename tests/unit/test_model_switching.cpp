@@ -14,7 +14,7 @@
 #include "lash/blocks/deadzone.hpp"
 #include "lash/blocks/first_order.hpp"
 #include "lash/identify/estimators.hpp"
-#include "lash/identify/intervals.hpp"
+#include "lash/identify/any_estimator.hpp"
 
 namespace lash {
 namespace {
@@ -95,7 +95,7 @@ TEST(ModelSwitching, WithoutAUsableSwitchingModelTheEstimatorIsRefused) {
 }
 
 TEST(ModelSwitching, IntervalsAreTheDeleteAGroupJackknife) {
-  // batch_means_intervals under model switching with lambda = 1: the jackknife of intervals.hpp,
+  // add_intervals under model switching with lambda = 1 attaches the jackknife of intervals.hpp,
   // recomputed here from its definition. Replicate b is a separate record (the samples without
   // group b, made here) run from the start, restarted where the group was cut out; the interval
   // is theta +- t_{0.975,9} sqrt((B - 1)/B sum (theta_b - mean)^2), t from scipy.stats.t.ppf.
@@ -121,7 +121,12 @@ TEST(ModelSwitching, IntervalsAreTheDeleteAGroupJackknife) {
     return PerSide<SideParams>{est.params(Side::right), est.params(Side::left)};
   };
   const PerSide<SideParams> whole = run(v, y, v.size());
-  const PerSide<SideIntervals> ci = batch_means_intervals(cfg, v, y, whole);
+  EstimationRun attached;
+  attached.report.model = ModelKind::deadzone_deadband;
+  attached.report.right.params = whole.right;
+  attached.report.left.params = whole.left;
+  add_intervals(attached, cfg, v, y);
+  const PerSide<SideIntervals> ci{attached.report.right.ci95, attached.report.left.ci95};
   constexpr std::size_t B = 10;
   const std::size_t n = v.size(), len = n / B;
   std::vector<PerSide<SideParams>> rep;

@@ -24,7 +24,7 @@ struct SideReport {
   SideParams params;  ///< NaN = not identified (JSON null); params.identified/reason: the full verdict
   double K = std::numeric_limits<double>::quiet_NaN();      ///< static gain b1/(1 + a1) [y unit / v unit]
   double tau_s = std::numeric_limits<double>::quiet_NaN();  ///< time constant −T/ln(−a1) [s]
-  SideIntervals ci95;  ///< 95 % intervals (batch means, intervals.hpp); only when asked for
+  SideIntervals ci95;  ///< 95 % intervals (add_intervals, intervals.hpp); only when asked for
   std::vector<std::pair<std::string, std::uint64_t>> updates;  ///< per key: "+"/"-" or "all"
 };
 
@@ -242,8 +242,9 @@ EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> 
                             bool keep_trace = false,
                             const std::function<void(const AnyEstimator&)>& at_end = {},
                             std::span<const std::size_t> gap_rows = {});
-/// Adds the 95 % intervals of every identified side's parameters to run.report (batch means,
-/// intervals.hpp: runs the estimator once more over sections of the same record).
+/// Adds the 95 % intervals of every identified side's parameters to run.report (intervals.hpp):
+/// under model switching with λ = 1 the delete-a-group jackknife (ten more runs over nine tenths
+/// of the record), else batch means (one more run over sections of the same record).
 void add_intervals(EstimationRun& run, const EstimatorConfig& cfg, const RecordColumns& record,
                    std::span<const std::size_t> gap_rows = {});
 void add_intervals(EstimationRun& run, const EstimatorConfig& cfg, std::span<const double> v,

@@ -51,8 +51,8 @@ PerSide<SideIntervals> batch_means_intervals(const EstimatorConfig& cfg, std::sp
 PerSide<SideIntervals> batch_means_intervals(const EstimatorConfig& cfg, const RecordColumns& record,
                                              const PerSide<SideParams>& estimate, const IntervalSettings& s = {});
 
-/// Under model switching with λ = 1 (docs/method.md §A4.4b) batch_means_intervals gives these
-/// instead: the **delete-a-group jackknife** (Quenouille 1956; Efron & Stein 1981; Kott 2001,
+/// Under model switching with λ = 1 (docs/method.md §A4.4b) add_intervals (any_estimator.hpp)
+/// attaches these instead of batch means: the **delete-a-group jackknife** (Quenouille 1956; Efron & Stein 1981; Kott 2001,
 /// "The delete-a-group jackknife", J. Official Statistics 17(4)). Replicate b runs the same
 /// estimator over the record without its b-th of B consecutive groups (restarting where the group
 /// was cut out); with the replicates θ_(1) … θ_(B), var θ = (B − 1)/B · Σ (θ_(b) − θ̄)² and the
