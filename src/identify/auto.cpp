@@ -156,6 +156,16 @@ const char* to_string(GuessSource s) noexcept {
   return "unused";
 }
 
+const char* to_string(SwitchTrigger t) noexcept {
+  switch (t) {
+    case SwitchTrigger::asked: return "asked";
+    case SwitchTrigger::side_open: return "side_open";
+    case SwitchTrigger::no_interval: return "no_interval";
+    case SwitchTrigger::none: break;
+  }
+  return "none";
+}
+
 EstimatorConfig preset_config(ModelKind model, Preset preset, double dt_s) {
   return preset == Preset::thesis ? EstimatorConfig::thesis(model, dt_s) : EstimatorConfig(model, dt_s);
 }
@@ -455,12 +465,12 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, const RecordColumns& rec, con
       return !(direct_ci->right.a1.valid() && direct_ci->left.a1.valid());
     };
     const int direct_sides = sides_identified(direct.report);
-    const char* trigger = forced                                   ? "asked"
-                          : given                                  ? nullptr
-                          : direct_sides < 2                       ? "side_open"
-                          : unconfirmed()                          ? "no_interval"
-                                                                   : nullptr;
-    if (trigger) {
+    const SwitchTrigger trigger = forced             ? SwitchTrigger::asked
+                                  : given            ? SwitchTrigger::none
+                                  : direct_sides < 2 ? SwitchTrigger::side_open
+                                  : unconfirmed()    ? SwitchTrigger::no_interval
+                                                     : SwitchTrigger::none;
+    if (trigger != SwitchTrigger::none) {
       out.switching.trigger = trigger;
       const DataTraits d = edit_rows.empty() && o.traits && o.traits->dt_s == cfg.dt_s
                                ? *o.traits
@@ -496,7 +506,7 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, const RecordColumns& rec, con
       out.switching.tried = true;
       // adopted: asked for; identifies more sides; or, checking an unconfirmed ẏ result, identifies both
       use_model = best && (forced || sides_identified(best->report) > direct_sides ||
-                           (out.switching.trigger == "no_interval" && sides_identified(best->report) == 2));
+                           (trigger == SwitchTrigger::no_interval && sides_identified(best->report) == 2));
       if (use_model) {
         mc.switch_model = best_model;
         cfg = mc;

@@ -258,7 +258,7 @@ std::string estimate_auto_json(const AutoRun& ar, Preset preset, const ReportFit
             {"converged", ar.switching.converged},
             {"passes", ar.switching.passes},
             {"starts", ar.switching.starts},
-            {"trigger", ar.switching.trigger}};
+            {"trigger", to_string(ar.switching.trigger)}};
     if (ar.switching.used)
       for (const auto& [name, sd] : {std::pair{"right", &m.right}, std::pair{"left", &m.left}})
         sw["model"][name] = {{"a1", num(sd->a1)}, {"b1", num(sd->b1)}, {"c", num(sd->c)}, {"d", num(sd->d)}};
@@ -286,7 +286,7 @@ std::string estimate_auto_text(const AutoRun& ar, double dt_s, const ReportFit& 
     out += fmt::format("model switching: {} after {} runs ({}){}{}\n", ar.switching.used ? "used" : "not used",
                        ar.switching.passes, ar.switching.converged ? "converged" : "did not converge",
                        ar.switching.used ? "" : "; the result is the dy/dt switching's",
-                       ar.switching.trigger == "no_interval"
+                       ar.switching.trigger == SwitchTrigger::no_interval
                            ? "; tried because the dy/dt switching's estimate had no 95 % interval"
                            : "");
   return out;

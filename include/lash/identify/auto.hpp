@@ -77,6 +77,17 @@ struct GuessReport {
   double edge = 0.0;           ///< the edge the check used [v unit] (NaN: none)
 };
 
+/// Why estimate_auto ran model switching (docs/method.md §A4.4b).
+enum class SwitchTrigger {
+  none,         ///< it did not run
+  asked,        ///< --model-switching
+  side_open,    ///< the ẏ switching left a side unidentified
+  no_interval,  ///< the ẏ switching identified both, but batch means' sections could not give a
+                ///< side an interval: an estimate that rests on few samples
+};
+/// The JSON / text name: "none", "asked", "side_open", "no_interval".
+const char* to_string(SwitchTrigger t) noexcept;
+
 /// What model switching (docs/method.md §A4.4b) did in estimate_auto.
 struct SwitchingReport {
   bool tried = false;      ///< the iteration ran (deadzone-deadband, pooled)
@@ -84,10 +95,7 @@ struct SwitchingReport {
   bool converged = false;  ///< the switching model stopped moving (within the tolerance)
   int passes = 0;          ///< runs over the record the iterations took (all starts)
   int starts = 0;          ///< starting models tried (lags of 10, 100, 30, 300 samples)
-  /// why it ran: "asked" (--model-switching), "side_open" (the ẏ switching left a side
-  /// unidentified), "no_interval" (it identified both, but batch means' sections could not give a
-  /// side an interval: an estimate that rests on few samples, docs/method.md §A4.4b)
-  std::string trigger;
+  SwitchTrigger trigger = SwitchTrigger::none;  ///< why it ran
 };
 struct AutoRun {
   EstimatorConfig cfg;         ///< the settings of the final run (what --print-config writes)
