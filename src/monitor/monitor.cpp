@@ -407,12 +407,9 @@ void check_settings(const MonitorSettings& s) {
   } catch (const std::invalid_argument& e) {
     throw InputError("", 0, "reguess", e.what());
   }
-  // model switching is an offline iteration over a whole record (docs/method.md §A4.4b): the
-  // window estimate runs it, the online estimator has no switching model to run with
-  if (resolve_settings(s.estimator).cfg.model_switching && s.mode == EstimateMode::online)
-    throw InputError("", 0, "model-switching",
-                     "needs --estimate window: model switching iterates over a whole window, the online "
-                     "estimator cannot");
+  (void)resolve_settings(s.estimator);  // the estimator's settings (a bad key or value fails here)
+  // what the online estimator refuses (model switching), refused before the source opens
+  if (s.mode == EstimateMode::online) (void)OnlineEstimator(s.estimator, s.online);
   (void)make_map(s);
 }
 

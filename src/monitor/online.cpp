@@ -27,6 +27,12 @@ OnlineEstimator::OnlineEstimator(const SettingsSources& src, const OnlineSetting
   if (s.sections < 2) throw std::invalid_argument("sections must be >= 2");
   if (!(std::isfinite(s.section_s) && s.section_s > 0)) throw std::invalid_argument("section_s must be > 0 [s]");
   s.reguess.validate();
+  // model switching is an offline iteration over a whole record (docs/method.md §A4.4b): there is
+  // no switching model to run with sample by sample (the estimator would refuse every stretch)
+  if (resolve_settings(src).cfg.model_switching)
+    throw InputError("", 0, "model-switching",
+                     "needs --estimate window: model switching iterates over a whole window, the online "
+                     "estimator cannot");
   OutlierGateConfig gc;
   gc.gate = s.outlier_gate;
   gate_ = OutlierGate(gc);

@@ -244,6 +244,22 @@ TEST(MonitorOnline, EqualsTheEstimatorSteppedOnce) {
   EXPECT_NEAR(ref.params(Side::left).c, -250.0, 12.5);
 }
 
+TEST(MonitorOnline, RefusesModelSwitchingAtConstruction) {
+  // model switching needs a whole record (a switching model iterated over it); the online
+  // estimator refuses it when made, naming the option, rather than at every stretch it tries
+  SettingsSources src;
+  src.model = ModelKind::deadzone_deadband;
+  src.options = {{"model-switching", "true"}};
+  try {
+    monitor::OnlineEstimator on(src, monitor::OnlineSettings{});
+    ADD_FAILURE() << "model switching was accepted online";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "model-switching");
+  }
+  src.options.clear();
+  EXPECT_NO_THROW(monitor::OnlineEstimator(src, monitor::OnlineSettings{}));
+}
+
 TEST(MonitorOnline, ReguessesAGuessInsideTheDeadzone) {
   const DeadzoneRecord r = deadzone_record(12000, 300.0, -250.0);
   SettingsSources src;

@@ -59,7 +59,8 @@ struct OnlineSnapshot {
 
 class OnlineEstimator {
  public:
-  /// src: the estimator settings (as `lash estimate`), checked by the caller.
+  /// src: the estimator settings (as `lash estimate`), checked by the caller. Throws InputError
+  /// (field "model-switching") when they ask for model switching, which needs a whole record.
   OnlineEstimator(const SettingsSources& src, const OnlineSettings& s);
 
   /// One sample: t [s, increasing], v, y; restart: the regressors restart before it.
