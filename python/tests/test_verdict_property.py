@@ -1,0 +1,81 @@
+"""Issue 30 item 2, the verdict as a property, with fixed seeds (scripts/verdict_property.py; the
+longer runs and what they found: docs/identification.md, "The verdict as a property").
+
+Random plants, inputs (multisine, random steps, PRBS, sine, chirp) and accepted settings, noise-free,
+simulated by the script's own numpy plant. What always holds is asserted as such: settings lash
+cannot run are refused naming the setting, and a1 >= 0 is never identified. The property itself
+(every identified side within 1 % of the truth) does NOT hold yet: a few per cent of the identified
+sides are biased while their intervals are tight. The counts here are the measured ones for these
+seeds; the test fails when a change makes them worse, and prints every violation."""
+import os
+import sys
+
+import numpy as np
+
+import lash
+
+sys.path.insert(0, os.path.join(os.environ["LASH_SOURCE_DIR"], "scripts"))
+import verdict_property as vp  # noqa: E402
+
+
+def test_the_scripts_plant_is_the_thesis_model():
+    # the independent simulator against lash's (a plant of the same blocks): the same bits
+    rng = np.random.default_rng(5)
+    p = vp.plant(rng)
+    v = vp.signal("multisine", rng, 20000, 500.0)
+    plant = lash.Plant(blocks=[{"kind": "deadzone", "left": p["cl"], "right": p["cr"]},
+                               {"kind": "linear", "a1": p["a1"], "b1": p["b1"]},
+                               {"kind": "deadband", "half_width": {"left": p["dl"], "right": p["dr"]}}], dt_s=vp.DT)
+    assert plant.simulate(v)["y"].tobytes() == vp.simulate(p, v).tobytes()
+
+
+def run(cases, seed, defaults):
+    out = dict(ok=0, violation=0, refused=0)
+    refused, violations = set(), []
+    for i in range(cases):
+        status, desc, info = vp.case(i, seed, False, defaults)  # noise-free
+        out[status] += 1
+        if status == "refused":
+            refused.add(info.split(":")[0])
+        elif status == "violation":
+            violations.append((desc, info["bad"]))
+            print("VIOLATION", desc, info["bad"])
+            assert not any("a1 = " in b for b in info["bad"]), "a1 >= 0 identified"
+    return out, refused, violations
+
+
+def test_random_settings():
+    out, refused, violations = run(200, 2, False)
+    print(out)
+    # refusals: lambda = 1e-300 ("forgetting factor must be in [0.9, 1]") and model switching
+    # without the pooled regression; nothing else the script draws is refused
+    assert refused == {"lambda", "model-switching"}
+    assert out["refused"] == 26
+    # measured: 12 of 174 runs with a side off by more than 1 % (7 of them by more than 20 %)
+    assert out["violation"] <= 12
+
+
+def test_defaults():
+    out, refused, violations = run(300, 3, True)
+    print(out)
+    assert out["refused"] == 0
+    # measured: 7 of 300 runs with a side off by more than 1 % (lash's defaults; 4 of them sines)
+    assert out["violation"] <= 7
+
+
+def test_interval_coverage_with_noise():
+    # item 3 over the property's cases with E2-level noise (1.4 % of the output's amplitude) and
+    # lash's defaults: of the identified sides that have intervals, the share whose 95 % interval
+    # holds the true value, per parameter. Measured: a1 560/604, b1 565/604, c 584/604, d 572/604
+    # (92.7 / 93.5 / 96.7 / 94.7 %); 175 identified sides had no interval. On the first 300
+    # cases alone a1 was 158/177 (89.3 %): fewer cases than this spread about 90 % leaves to chance.
+    cover = {k: [0, 0] for k in ("a1", "b1", "c", "d")}
+    for i in range(1000):
+        status, desc, info = vp.case(i, 3, True, True)
+        for k, held in info["cover"]:
+            cover[k][0] += held
+            cover[k][1] += 1
+    print(cover)
+    assert cover["a1"][1] >= 500
+    for k, (held, m) in cover.items():
+        assert held >= 0.90 * m, (k, held, m)
