@@ -52,16 +52,16 @@ PerSide<SideIntervals> batch_means_intervals(const EstimatorConfig& cfg, const R
                                              const PerSide<SideParams>& estimate, const IntervalSettings& s = {});
 
 /// Under model switching with λ = 1 (docs/method.md §A4.4b) add_intervals (any_estimator.hpp)
-/// attaches these instead of batch means: the **delete-a-group jackknife** (Quenouille 1956; Efron & Stein 1981; Kott 2001,
-/// "The delete-a-group jackknife", J. Official Statistics 17(4)). Replicate b runs the same
-/// estimator over the record without its b-th of B consecutive groups (restarting where the group
-/// was cut out); with the replicates θ_(1) … θ_(B), var θ = (B − 1)/B · Σ (θ_(b) − θ̄)² and the
-/// interval θ ± t_{0.975, B−1} · √var. Why: with λ = 1 the IV estimate is a smooth function of
-/// sums over the samples (the normal equations Σ z φᵀ, Σ z y), which the jackknife covers, and a
-/// side driven beyond its edge only now and then gets too few updates in a tenth of the record for
-/// batch means' sections, while each replicate holds nine tenths; contiguous groups keep the
-/// equation error's correlation inside a group, as sections do. A side gets intervals only when
-/// every replicate identifies it.
+/// attaches these instead of batch means: the **delete-a-group jackknife** (Quenouille 1956; Efron
+/// & Stein 1981; Kott 2001, "The delete-a-group jackknife", J. Official Statistics 17(4)).
+/// Replicate b runs the same estimator over the record without its b-th of B consecutive groups
+/// (restarting where the group was cut out); with the replicates θ_(1) … θ_(B), var θ = (B − 1)/B ·
+/// Σ (θ_(b) − θ̄)² and the interval θ ± t_{0.975, B−1} · √var. Why: with λ = 1 the IV estimate is a
+/// smooth function of sums over the samples (the normal equations Σ z φᵀ, Σ z y), which the
+/// jackknife covers, and a side driven beyond its edge only now and then gets too few updates in a
+/// tenth of the record for batch means' sections, while each replicate holds nine tenths;
+/// contiguous groups keep the equation error's correlation inside a group, as sections do. A side
+/// gets intervals only when every replicate identifies it.
 PerSide<SideIntervals> jackknife_intervals(const EstimatorConfig& cfg, const RecordColumns& record,
                                            const PerSide<SideParams>& estimate, const IntervalSettings& s = {});
 
