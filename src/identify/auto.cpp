@@ -442,9 +442,10 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, const RecordColumns& rec, con
     out.run = run_estimator(cfg, rec, ro);
   } else {
     // First the ẏ switching; model switching when it leaves a side unidentified, when its
-    // estimate has no batch-means interval (below), or when asked for. A trace streamed as it goes (on_step) cannot be taken back: then the first runs keep
-    // nothing per sample and the final run is done again with everything; kept outputs and
-    // traces are kept by every run and the adopted one is used as it is.
+    // estimate has no batch-means interval (below), or when asked for. A trace streamed as it
+    // goes (on_step) cannot be taken back: then the first runs keep nothing per sample and the
+    // final run is done again with everything; kept outputs and traces are kept by every run and
+    // the adopted one is used as it is.
     const EstimatorConfig dcfg = cfg;
     RunOptions probe = ro;
     probe.keep_trace = probe.keep_outputs = false;
