@@ -110,7 +110,8 @@ def relerr(got, want):
     return math.inf if got is None else abs(got / want - 1.0)
 
 
-def case(i, seed, noise, defaults=False, extra=None):
+def draw(i, seed, noise):
+    """case i's plant, input kind, amplitude, v and y; and its generator, to draw the settings"""
     rng = np.random.default_rng([seed, i])
     p = plant(rng)
     kind = str(rng.choice(KINDS))
@@ -120,6 +121,12 @@ def case(i, seed, noise, defaults=False, extra=None):
     y = simulate(p, v)
     if noise:  # E2-level: 1.4 % of the output's amplitude
         y = y + rng.normal(0.0, 0.014 * np.abs(y).max(), n)
+    return p, kind, amp, v, y, rng
+
+
+def case(i, seed, noise, defaults=False, extra=None):
+    p, kind, amp, v, y, rng = draw(i, seed, noise)
+    n = len(v)
     s = settings(rng)
     if defaults:
         s = dict(preset="lash", outlier_gate=12.0, keys=dict(extra or {}))

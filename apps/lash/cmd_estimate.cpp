@@ -135,7 +135,7 @@ int run(const CLI::App& sub, const EstimateOptions& o) {
                rec.rows(), format_double(e.estimator_s), static_cast<double>(rec.rows()) / e.estimator_s * 1e-6,
                format_double(e.estimator_cpu_s));
   if (o.print_config) {
-    fmt::print("{}", config_to_toml(e.run.cfg, &e.job));
+    fmt::print("{}", config_to_toml(e.run.settings, &e.job));
     return kExitOk;
   }
   // the result first: a failing -o or --plot never hides it

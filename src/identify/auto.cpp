@@ -118,15 +118,21 @@ PerSide<SwitchSide> iterate_switching(const EstimatorConfig& mc0, const RecordCo
 /// Where the model-switching iteration starts: an identified side's values, else a first-order
 /// lag of `lag` samples (a1 = −exp(−1/lag)), b1 = (1 + a1)·K with K = output span / input span,
 /// c = 0.3 × the input's extreme on that side, d = 0 (docs/method.md §A4.4b).
+/// The side's start taken from the ẏ result `r`, if it identified it with usable values.
+std::optional<SwitchSide> start_from(const EstimateReport& r, Side s) {
+  const SideParams& p = (s == Side::right ? r.right : r.left).params;
+  if (const SwitchSide q{p.a1, p.b1, p.c, std::max(p.d, 0.0)}; p.identified && q.usable()) return q;
+  return std::nullopt;
+}
+
 PerSide<SwitchSide> switching_start(const EstimateReport& r, const DataTraits& d, double lag) {
   const double vspan = d.v_hi - d.v_lo;
   const double k = vspan > 0.0 && d.y_span > 0.0 ? d.y_span / vspan : 1.0;
   const double a1 = -std::exp(-1.0 / lag);
   PerSide<SwitchSide> m;
   for (const Side s : {Side::right, Side::left}) {
-    const SideParams& p = (s == Side::right ? r.right : r.left).params;
-    if (const SwitchSide q{p.a1, p.b1, p.c, std::max(p.d, 0.0)}; p.identified && q.usable())
-      m[s] = q;
+    if (const auto q = start_from(r, s))
+      m[s] = *q;
     else
       m[s] = {a1, (1.0 + a1) * k, 0.3 * (s == Side::right ? std::max(d.v_hi, 0.0) : std::min(d.v_lo, 0.0)), 0.0};
   }
@@ -135,6 +141,20 @@ PerSide<SwitchSide> switching_start(const EstimateReport& r, const DataTraits& d
 
 int sides_identified(const EstimateReport& r) {
   return (r.right.params.identified ? 1 : 0) + (r.left.params.identified ? 1 : 0);
+}
+
+// The check of a ẏ result (§A4.4b): the model-switched estimate `m` lies further from the ẏ
+// estimate than the width of its 95 % interval (twice the half-width) in some parameter of a side.
+bool departs(const EstimateReport& m, const EstimateReport& ydot, const PerSide<SideIntervals>& ci) {
+  for (const Side s : {Side::right, Side::left}) {
+    const SideParams &a = (s == Side::right ? m.right : m.left).params;
+    const SideParams &b = (s == Side::right ? ydot.right : ydot.left).params;
+    const SideIntervals& i = ci[s];
+    for (const auto& [x, y, iv] : {std::tuple{a.a1, b.a1, i.a1}, std::tuple{a.b1, b.b1, i.b1},
+                                   std::tuple{a.c, b.c, i.c}, std::tuple{a.d, b.d, i.d}})
+      if (iv.valid() && !(std::fabs(x - y) <= iv.hi - iv.lo)) return true;
+  }
+  return false;
 }
 
 }  // namespace
@@ -161,6 +181,7 @@ const char* to_string(SwitchTrigger t) noexcept {
     case SwitchTrigger::asked: return "asked";
     case SwitchTrigger::side_open: return "side_open";
     case SwitchTrigger::no_interval: return "no_interval";
+    case SwitchTrigger::check: return "check";
     case SwitchTrigger::none: break;
   }
   return "none";
@@ -455,9 +476,10 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, const RecordColumns& rec, con
     bool use_model = false;
     // given guesses are the user's switching: kept (a wrong one is reported as such)
     const bool given = std::isfinite(cfg0.guess_right) || std::isfinite(cfg0.guess_left);
-    // both sides identified by the ẏ switching but not reproduced by batch means (fewer than 5 of
-    // 10 sections identify a side: no interval): the estimate rests on few selected samples,
-    // where the ẏ selection's bias shows (§A4.4b); model switching checks it
+    // both sides identified by the ẏ switching: model switching checks the result (§A4.4b) --
+    // `no_interval` when batch means cannot reproduce a side (fewer than 5 of 10 sections
+    // identify it: the estimate rests on few selected samples, where the ẏ selection's bias
+    // shows), `check` otherwise
     std::optional<PerSide<SideIntervals>> direct_ci;  // kept: the report's intervals when the ẏ result stays
     const auto unconfirmed = [&] {
       IntervalSettings is;
@@ -470,7 +492,7 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, const RecordColumns& rec, con
                                   : given            ? SwitchTrigger::none
                                   : direct_sides < 2 ? SwitchTrigger::side_open
                                   : unconfirmed()    ? SwitchTrigger::no_interval
-                                                     : SwitchTrigger::none;
+                                                     : SwitchTrigger::check;
     if (trigger != SwitchTrigger::none) {
       out.switching.trigger = trigger;
       const DataTraits d = edit_rows.empty() && o.traits && o.traits->dt_s == cfg.dt_s
@@ -503,11 +525,16 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, const RecordColumns& rec, con
           best_model = mc.switch_model;
         }
         if (sides_identified(best->report) == 2) break;
+        // both sides start from the ẏ result: every lag gives the same start, and the same run
+        if (start_from(direct.report, Side::right) && start_from(direct.report, Side::left)) break;
       }
       out.switching.tried = true;
-      // adopted: asked for; identifies more sides; or, checking an unconfirmed ẏ result, identifies both
+      // adopted: asked for; identifies more sides; or, checking a ẏ result, identifies both (and,
+      // for a ẏ result with intervals, departs from it by more than their width or fits better)
       use_model = best && (forced || sides_identified(best->report) > direct_sides ||
-                           (trigger == SwitchTrigger::no_interval && sides_identified(best->report) == 2));
+                           (sides_identified(best->report) == 2 &&
+                            (trigger == SwitchTrigger::no_interval || departs(best->report, direct.report, *direct_ci) ||
+                             best->report.fit_nrmse < direct.report.fit_nrmse)));
       if (use_model) {
         mc.switch_model = best_model;
         cfg = mc;
@@ -523,6 +550,7 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, const RecordColumns& rec, con
       out.run = streams ? run_estimator(dcfg, rec, ro) : std::move(direct);
     }
   }
+  out.settings = out.switching.used ? cfg0 : cfg;
   if (out.switching.used) {
     out.right.edge = out.left.edge = detail::kNaN;
   } else if (uses_guesses(cfg.model)) {

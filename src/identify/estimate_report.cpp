@@ -288,7 +288,8 @@ std::string estimate_auto_text(const AutoRun& ar, double dt_s, const ReportFit& 
                        ar.switching.used ? "" : "; the result is the dy/dt switching's",
                        ar.switching.trigger == SwitchTrigger::no_interval
                            ? "; tried because the dy/dt switching's estimate had no 95 % interval"
-                           : "");
+                       : ar.switching.trigger == SwitchTrigger::check ? "; run to check the dy/dt switching's estimate"
+                                                                      : "");
   return out;
 }
 

@@ -84,8 +84,10 @@ enum class SwitchTrigger {
   side_open,    ///< the ẏ switching left a side unidentified
   no_interval,  ///< the ẏ switching identified both, but batch means' sections could not give a
                 ///< side an interval: an estimate that rests on few samples
+  check,        ///< the ẏ switching identified both with intervals; model switching checks it
+                ///< (the ẏ selection is biased where its window straddles a reversal, §A4.4b)
 };
-/// The JSON / text name: "none", "asked", "side_open", "no_interval".
+/// The JSON / text name: "none", "asked", "side_open", "no_interval", "check".
 const char* to_string(SwitchTrigger t) noexcept;
 
 /// What model switching (docs/method.md §A4.4b) did in estimate_auto.
@@ -98,7 +100,11 @@ struct SwitchingReport {
   SwitchTrigger trigger = SwitchTrigger::none;  ///< why it ran
 };
 struct AutoRun {
-  EstimatorConfig cfg;         ///< the settings of the final run (what --print-config writes)
+  EstimatorConfig cfg;         ///< the settings of the final run
+  /// The settings that give this run again through estimate_auto (what --print-config writes): the
+  /// final run's, with the searched guesses; when model switching was kept, the settings given
+  /// (its switching model comes from the iteration, which the same settings repeat exactly).
+  EstimatorConfig settings;
   SwitchingReport switching;
   EstimationRun run;
   GuessReport right, left;
