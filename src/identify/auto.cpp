@@ -115,9 +115,6 @@ PerSide<SwitchSide> iterate_switching(const EstimatorConfig& mc0, const RecordCo
   return model;
 }
 
-/// Where the model-switching iteration starts: an identified side's values, else a first-order
-/// lag of `lag` samples (a1 = −exp(−1/lag)), b1 = (1 + a1)·K with K = output span / input span,
-/// c = 0.3 × the input's extreme on that side, d = 0 (docs/method.md §A4.4b).
 /// The side's start taken from the ẏ result `r`, if it identified it with usable values.
 std::optional<SwitchSide> start_from(const EstimateReport& r, Side s) {
   const SideParams& p = (s == Side::right ? r.right : r.left).params;
@@ -125,6 +122,9 @@ std::optional<SwitchSide> start_from(const EstimateReport& r, Side s) {
   return std::nullopt;
 }
 
+/// Where the model-switching iteration starts: an identified side's values, else a first-order
+/// lag of `lag` samples (a1 = −exp(−1/lag)), b1 = (1 + a1)·K with K = output span / input span,
+/// c = 0.3 × the input's extreme on that side, d = 0 (docs/method.md §A4.4b).
 PerSide<SwitchSide> switching_start(const EstimateReport& r, const DataTraits& d, double lag) {
   const double vspan = d.v_hi - d.v_lo;
   const double k = vspan > 0.0 && d.y_span > 0.0 ? d.y_span / vspan : 1.0;

@@ -108,8 +108,8 @@ with tempfile.TemporaryDirectory() as d:
         j = estimate(rec)
         within(j, 1.0, f"E2 seed {seed}")
         # the dy/dt switching runs on searched guesses; model switching checks its result and is
-        # kept when its free run fits the record better (docs/method.md §A4.4b): then the final
-        # run used no guesses
+        # kept when it departs from it by more than its interval's width or its free run fits the
+        # record better (docs/method.md §A4.4b): then the final run used no guesses
         ms = j["model_switching"]
         if ms["used"]:
             check(ms["trigger"] == "check" and ms["converged"], f"E2 seed {seed}: model switching kept as a check ({ms})")
