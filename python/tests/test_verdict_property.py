@@ -66,9 +66,9 @@ def test_defaults():
 
 def test_model_switching_checks_a_biased_ydot_result():
     # noise-free sines and chirps (defaults, seed 3) whose dy/dt switching identified both sides
-    # with d 2-21 % off and batch-means intervals of about +-0.3 % (measured before the check, 2c2b43d):
-    # model switching checks every such result and replaces it (docs/method.md A4.4b); the result
-    # is then within 0.1 % of the script's plant on every parameter of both sides
+    # with d 2-21 % off and batch-means intervals of about +-0.3 % (measured before the check,
+    # 2c2b43d): model switching checks every such result and replaces it (docs/method.md A4.4b);
+    # the result is then within 0.1 % of the script's plant on every parameter of both sides
     for i in (26, 247, 374, 375, 487):
         p, kind, amp, v, y, rng = vp.draw(i, 3, False)
         r = lash.estimate(np.arange(len(v)) * vp.DT, v, y, model="deadzone-deadband").to_dict()
