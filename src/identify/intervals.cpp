@@ -183,15 +183,23 @@ PerSide<SideIntervals> jackknife_intervals(const EstimatorConfig& cfg, const Rec
   const std::size_t n = rec.size(), B = s.sections, len = group_len(n, B);
   if (len == 0) return {};
   std::vector<PerSide<SideParams>> reps(B);
-  AnyEstimator e(cfg);
+  // Replicate b: the record without group b (the last: to the end). Every replicate's run over
+  // [0, g0) is the first g0 rows of one run: `prefix` advances group by group and each replicate
+  // starts from a copy of it (the same state, hence the same bits as a run from row 0), so the
+  // ten replicates step through 5.4 records' rows instead of 9.
+  AnyEstimator prefix(cfg);
   const auto none = [](std::size_t, double, const auto&) {};
-  for (std::size_t b = 0; b < B; ++b) {  // replicate b: the record without group b (the last: to the end)
+  for (std::size_t b = 0; b < B; ++b) {
     const std::size_t g0 = b * len, g1 = b + 1 == B ? n : g0 + len;
-    e.reset();
-    step_through(e, rec, 0, g0, s.gap_rows, none);
+    AnyEstimator e = prefix;
     e.restart();  // the samples on both sides of the group are not neighbours
     step_through(e, rec, g1, n, s.gap_rows, none);
     reps[b] = {e.params(Side::right), e.params(Side::left)};
+    if (b + 1 < B) {  // the next replicate's prefix: to g1
+      // step_through does not restart at its first row: a run from row 0 would restart at a gap there
+      if (g0 > 0 && std::binary_search(s.gap_rows.begin(), s.gap_rows.end(), g0)) prefix.restart();
+      step_through(prefix, rec, g0, g1, s.gap_rows, none);
+    }
   }
   // var = (B − 1)/B · Σ(θ_(b) − θ̄)² = sd² · (B − 1)²/B: sd · (B − 1)/√B; every replicate is needed
   const double fb = static_cast<double>(B);

@@ -4,6 +4,7 @@
 // ẏ switching cannot use (issue 30). A mathematical identity, checked to 1e-6 relative.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <stdexcept>
@@ -94,11 +95,13 @@ TEST(ModelSwitching, WithoutAUsableSwitchingModelTheEstimatorIsRefused) {
   EXPECT_NO_THROW(DeadzoneDeadbandEstimator{cfg});
 }
 
-TEST(ModelSwitching, IntervalsAreTheDeleteAGroupJackknife) {
-  // add_intervals under model switching with lambda = 1 attaches the jackknife of intervals.hpp,
-  // recomputed here from its definition. Replicate b is a separate record (the samples without
-  // group b, made here) run from the start, restarted where the group was cut out; the interval
-  // is theta +- t_{0.975,9} sqrt((B - 1)/B sum (theta_b - mean)^2), t from scipy.stats.t.ppf.
+namespace {
+// add_intervals under model switching with lambda = 1 attaches the jackknife of intervals.hpp,
+// recomputed here from its definition. Replicate b is a separate record (the samples without
+// group b, made here) run from the start, restarted where the group was cut out and at the
+// record's gaps (`gaps`: rows of the whole record; those inside group b are cut out with it); the
+// interval is theta +- t_{0.975,9} sqrt((B - 1)/B sum (theta_b - mean)^2), t from scipy.stats.t.ppf.
+void expect_delete_a_group_jackknife(const std::vector<std::size_t>& gaps) {
   const Plant p;
   std::vector<double> v, y;
   record(p, v, y);
@@ -112,20 +115,21 @@ TEST(ModelSwitching, IntervalsAreTheDeleteAGroupJackknife) {
   cfg.rls.lambda = 1.0;
   cfg.switch_model.right = {p.a1, p.b1, p.cr, p.dr};
   cfg.switch_model.left = {p.a1, p.b1, p.cl, p.dl};
-  const auto run = [&](const std::vector<double>& vv, const std::vector<double>& yy, std::size_t join) {
+  const auto run = [&](const std::vector<double>& vv, const std::vector<double>& yy,
+                       const std::vector<std::size_t>& restarts) {
     DeadzoneDeadbandEstimator est(cfg);
     for (std::size_t k = 0; k < vv.size(); ++k) {
-      if (k == join) est.restart();
+      if (k > 0 && std::find(restarts.begin(), restarts.end(), k) != restarts.end()) est.restart();
       est.step(vv[k], yy[k]);
     }
     return PerSide<SideParams>{est.params(Side::right), est.params(Side::left)};
   };
-  const PerSide<SideParams> whole = run(v, y, v.size());
+  const PerSide<SideParams> whole = run(v, y, gaps);
   EstimationRun attached;
   attached.report.model = ModelKind::deadzone_deadband;
   attached.report.right.params = whole.right;
   attached.report.left.params = whole.left;
-  add_intervals(attached, cfg, v, y);
+  add_intervals(attached, cfg, v, y, gaps);
   const PerSide<SideIntervals> ci{attached.report.right.ci95, attached.report.left.ci95};
   constexpr std::size_t B = 10;
   const std::size_t n = v.size(), len = n / B;
@@ -135,7 +139,11 @@ TEST(ModelSwitching, IntervalsAreTheDeleteAGroupJackknife) {
     std::vector<double> vb(v.begin(), v.begin() + static_cast<long>(g0)), yb(y.begin(), y.begin() + static_cast<long>(g0));
     vb.insert(vb.end(), v.begin() + static_cast<long>(g1), v.end());
     yb.insert(yb.end(), y.begin() + static_cast<long>(g1), y.end());
-    rep.push_back(run(vb, yb, g0));
+    std::vector<std::size_t> restarts{g0};  // the cut
+    for (const std::size_t g : gaps)
+      if (g < g0) restarts.push_back(g);
+      else if (g >= g1) restarts.push_back(g - (g1 - g0));
+    rep.push_back(run(vb, yb, restarts));
   }
   constexpr double t975_9 = 2.2621571627409915;  // scipy.stats.t.ppf(0.975, 9)
   for (const Side s : {Side::right, Side::left}) {
@@ -158,6 +166,15 @@ TEST(ModelSwitching, IntervalsAreTheDeleteAGroupJackknife) {
     check(whole[s].c, ci[s].c, &SideParams::c);
     check(whole[s].d, ci[s].d, &SideParams::d);
   }
+}
+}  // namespace
+
+TEST(ModelSwitching, IntervalsAreTheDeleteAGroupJackknife) { expect_delete_a_group_jackknife({}); }
+
+TEST(ModelSwitching, TheJackknifeRestartsAtTheRecordsGaps) {
+  // 30000 rows, groups of 3000: a gap on a group's first row (where add_intervals' run over the
+  // groups before it ends and the next begins), one inside a group, one inside the last
+  expect_delete_a_group_jackknife({9000, 16517, 28000});
 }
 
 TEST(ModelSwitching, ConfigIsChecked) {

@@ -243,8 +243,8 @@ EstimationRun run_estimator(const EstimatorConfig& cfg, std::span<const double> 
                             const std::function<void(const AnyEstimator&)>& at_end = {},
                             std::span<const std::size_t> gap_rows = {});
 /// Adds the 95 % intervals of every identified side's parameters to run.report (intervals.hpp):
-/// under model switching with λ = 1 the delete-a-group jackknife (ten more runs over nine tenths
-/// of the record), else batch means (one more run over sections of the same record).
+/// under model switching with λ = 1 the delete-a-group jackknife (5.4 more passes over the
+/// record), else batch means (one more run over sections of the same record).
 void add_intervals(EstimationRun& run, const EstimatorConfig& cfg, const RecordColumns& record,
                    std::span<const std::size_t> gap_rows = {});
 void add_intervals(EstimationRun& run, const EstimatorConfig& cfg, std::span<const double> v,
