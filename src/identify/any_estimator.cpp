@@ -171,7 +171,7 @@ void add_intervals(EstimationRun& run, const EstimatorConfig& cfg, std::span<con
 void attach_intervals(EstimateReport& rep, const PerSide<SideIntervals>& ci) {
   const bool two = model_traits(rep.model).two_sided;
   for (const Side s : {Side::right, Side::left}) {
-    SideReport& r = s == Side::right ? rep.right : rep.left;
+    SideReport& r = rep[s];
     if (!r.params.identified) continue;
     r.ci95 = ci[s];
     if (interval_verdict(ci[s], s) == Reason::none) continue;

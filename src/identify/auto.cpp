@@ -117,7 +117,7 @@ PerSide<SwitchSide> iterate_switching(const EstimatorConfig& mc0, const RecordCo
 
 /// The side's start taken from the ẏ result `r`, if it identified it with usable values.
 std::optional<SwitchSide> start_from(const EstimateReport& r, Side s) {
-  const SideParams& p = (s == Side::right ? r.right : r.left).params;
+  const SideParams& p = r[s].params;
   if (const SwitchSide q{p.a1, p.b1, p.c, std::max(p.d, 0.0)}; p.identified && q.usable()) return q;
   return std::nullopt;
 }
@@ -147,8 +147,7 @@ int sides_identified(const EstimateReport& r) {
 // estimate than the width of its 95 % interval (twice the half-width) in some parameter of a side.
 bool departs(const EstimateReport& m, const EstimateReport& ydot, const PerSide<SideIntervals>& ci) {
   for (const Side s : {Side::right, Side::left}) {
-    const SideParams &a = (s == Side::right ? m.right : m.left).params;
-    const SideParams &b = (s == Side::right ? ydot.right : ydot.left).params;
+    const SideParams &a = m[s].params, &b = ydot[s].params;
     const SideIntervals& i = ci[s];
     for (const auto& [x, y, iv] : {std::tuple{a.a1, b.a1, i.a1}, std::tuple{a.b1, b.b1, i.b1},
                                    std::tuple{a.c, b.c, i.c}, std::tuple{a.d, b.d, i.d}})
@@ -508,6 +507,8 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, const RecordColumns& rec, con
       // until a converged iteration identifies both sides; else the one that identifies most
       std::optional<EstimationRun> best;
       PerSide<SwitchSide> best_model{};
+      // both sides start from the ẏ result: every lag gives the same start, and the same run
+      const bool one_start = start_from(direct.report, Side::right) && start_from(direct.report, Side::left);
       for (const double lag : {10.0, 100.0, 30.0, 300.0}) {
         if (out.switching.passes >= kSwitchBudget) break;  // a long record: at most 80 + 40 runs
         SwitchingReport rep;
@@ -515,18 +516,18 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, const RecordColumns& rec, con
             iterate_switching(mc, rec, switching_start(direct.report, d, lag), d, o.gap_rows, edits, rep);
         out.switching.passes += rep.passes;
         ++out.switching.starts;
-        if (!rep.converged) continue;
-        out.switching.converged = true;
-        RunOptions mro = streams ? probe : ro;  // kept outputs are kept here: no rerun if adopted
-        mro.at_end = nullptr;                   // its edges are not guesses' evidence
-        EstimationRun m = run_estimator(mc, rec, mro);
-        if (!best || sides_identified(m.report) > sides_identified(best->report)) {
-          best = std::move(m);
-          best_model = mc.switch_model;
+        if (rep.converged) {
+          out.switching.converged = true;
+          RunOptions mro = streams ? probe : ro;  // kept outputs are kept here: no rerun if adopted
+          mro.at_end = nullptr;                   // its edges are not guesses' evidence
+          EstimationRun m = run_estimator(mc, rec, mro);
+          if (!best || sides_identified(m.report) > sides_identified(best->report)) {
+            best = std::move(m);
+            best_model = mc.switch_model;
+          }
+          if (sides_identified(best->report) == 2) break;
         }
-        if (sides_identified(best->report) == 2) break;
-        // both sides start from the ẏ result: every lag gives the same start, and the same run
-        if (start_from(direct.report, Side::right) && start_from(direct.report, Side::left)) break;
+        if (one_start) break;  // converged or not, another lag would repeat this iteration
       }
       out.switching.tried = true;
       // adopted: asked for; identifies more sides; or, checking a ẏ result, identifies both (and,

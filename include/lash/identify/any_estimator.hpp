@@ -42,6 +42,9 @@ struct EstimateReport {
   Reason d_reason = Reason::not_updated;                ///< coupled-carts: verdict of d
   double fit_nrmse = std::numeric_limits<double>::quiet_NaN();  ///< the verdict's free-run NRMSE (fraction)
   std::vector<std::pair<std::string, std::uint64_t>> d_updates;
+
+  SideReport& operator[](Side s) noexcept { return s == Side::right ? right : left; }
+  const SideReport& operator[](Side s) const noexcept { return s == Side::right ? right : left; }
 };
 
 /// Names of the per-step parameter columns of a model ("a1_r", "b1_r", "c_r", "d_r", …; the
