@@ -36,12 +36,17 @@ AlarmSettings read_alarm_settings(TomlTable& t) {
     std::map<std::string, Threshold> by;
     for (const auto& [key, node] : *raw) {
       const std::string k(key.str());
+      if (k == "warmup_s") {
+        s.warmup_s = a->number(k);
+        if (!(s.warmup_s >= 0) || !std::isfinite(s.warmup_s)) a->fail(k, "must be finite and >= 0");
+        continue;
+      }
       const bool is_max = k.size() > 4 && k.compare(k.size() - 4, 4, "_max") == 0;
       const bool is_min = k.size() > 4 && k.compare(k.size() - 4, 4, "_min") == 0;
       const std::string p = canonical(k.substr(0, k.size() >= 4 ? k.size() - 4 : 0));
       if ((!is_max && !is_min) || !known_params().count(p))
-        a->fail(k, "expected <parameter>_max or <parameter>_min with a parameter of c_r, c_l, d_r, d_l, K_r, K_l, "
-                   "tau_s_r, tau_s_l, K, tau_s, d (right/left for r/l)");
+        a->fail(k, "expected warmup_s, or <parameter>_max or <parameter>_min with a parameter of c_r, c_l, d_r, d_l, "
+                   "K_r, K_l, tau_s_r, tau_s_l, K, tau_s, d (right/left for r/l)");
       const double v = a->number(k);
       if (!std::isfinite(v)) a->fail(k, "must be finite");
       auto& th = by[p];
@@ -133,7 +138,7 @@ void EventDetector::update(double t, const std::vector<ParamValue>& params, std:
                .first;
     Track& tr = it->second;
     for (const Threshold& th : s_.thresholds) {
-      if (th.param != p.name) continue;
+      if (th.param != p.name || t - t0_ < s_.warmup_s) continue;  // armed after the warm-up
       const bool outside = p.value > th.max || p.value < th.min;
       if (outside && !tr.outside) out.push_back({t, "threshold", p.name, tr.last, p.value});
       tr.outside = outside;

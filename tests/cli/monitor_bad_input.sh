@@ -31,6 +31,8 @@ expect "model-switching" -- "$tmp/a.log" --dbc "$DBC" --v $V --y BenchSensors.Pi
   { echo "FAIL: --estimate window with model_switching -> rc $?, stderr: $(cat "$tmp/err")"; fail=1; }
 printf '[alarms]\nq_r_max = 3\n' > "$tmp/bad.toml"
 expect "q_r_max" -- "$tmp/a.log" --dbc "$DBC" --v $V --y BenchSensors.PilotPressure_kPa --model linear --config "$tmp/bad.toml"
+printf '[alarms]\nwarmup_s = -1\nc_r_max = 350\n' > "$tmp/bad.toml"
+expect "warmup_s" -- "$tmp/a.log" --dbc "$DBC" --v $V --y BenchSensors.PilotPressure_kPa --model linear --config "$tmp/bad.toml"
 expect "missing.sqlite" -- --report "$tmp/missing.sqlite" -o "$tmp/x.png"
 [[ ! -e "$tmp/x.png" ]] || { echo "FAIL: a PNG was left behind"; fail=1; }
 exit $fail

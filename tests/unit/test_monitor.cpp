@@ -141,6 +141,7 @@ TEST(MonitorSignals, UnknownSignalNamesIt) {
 TEST(MonitorEvents, ThresholdOnce) {
   monitor::AlarmSettings s;
   s.drift.enabled = false;
+  s.warmup_s = 0.0;
   s.thresholds.push_back({"d_r", -1e9, 40.0});
   monitor::EventDetector d(s);
   std::vector<monitor::Event> ev;
@@ -158,6 +159,27 @@ TEST(MonitorEvents, ThresholdOnce) {
   EXPECT_DOUBLE_EQ(ev[0].before, 30);
   EXPECT_DOUBLE_EQ(ev[0].after, 45);
   EXPECT_DOUBLE_EQ(ev[1].t, 5);
+}
+
+// Thresholds are armed warmup_s (8 s, the default) after the first estimate (t0 = 1 here): the
+// excursions at 4 and 8 (t - t0 = 3, 7) fire nothing; a value still outside at 9 (t - t0 = 8)
+// fires then, with `before` the period before; after that, edge-triggered as above.
+TEST(MonitorEvents, ThresholdArmedAfterTheWarmUp) {
+  monitor::AlarmSettings s;
+  s.drift.enabled = false;
+  ASSERT_DOUBLE_EQ(s.warmup_s, 8.0);
+  s.thresholds.push_back({"c_r", -1e9, 350.0});
+  monitor::EventDetector d(s);
+  std::vector<monitor::Event> ev;
+  for (const auto& [t, x] : {std::pair{1.0, 280.0}, {4.0, 406.0}, {5.0, 280.0}, {8.0, 400.0}, {9.0, 401.0},
+                             {10.0, 402.0}, {11.0, 290.0}, {12.0, 360.0}})
+    d.update(t, {monitor::ParamValue{"c_r", x, NAN, NAN, true, true}}, ev);
+  ASSERT_EQ(ev.size(), 2u);
+  EXPECT_DOUBLE_EQ(ev[0].t, 9);
+  EXPECT_DOUBLE_EQ(ev[0].before, 400);
+  EXPECT_DOUBLE_EQ(ev[0].after, 401);
+  EXPECT_DOUBLE_EQ(ev[1].t, 12);
+  EXPECT_DOUBLE_EQ(ev[1].before, 290);
 }
 
 // A step of c_r from 100 to 132 after 10 periods, δ = 0.03, h = 0.3, warm-up 0 (x = c/100, by hand):

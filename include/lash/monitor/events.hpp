@@ -3,7 +3,8 @@
 /// The monitor's events (docs/monitor.md, "Events"):
 ///  - `threshold`: an identified parameter leaves the band of `[alarms]` (`<param>_max`,
 ///    `<param>_min`; `right`/`left` may stand for the suffixes `r`/`l`: `d_right_max` = `d_r_max`).
-///    Edge-triggered: one event on leaving, re-armed on coming back inside.
+///    Edge-triggered: one event on leaving, re-armed on coming back inside. Armed `warmup_s`
+///    (`[alarms]`, default 8 s) after the first estimate: a value outside then fires at once.
 ///  - `drift`: the Page–Hinkley test (lash/metrics/page_hinkley.hpp) on the period-by-period
 ///    values of every identified parameter, relative to its value when the warm-up ended
 ///    (x / |x_ref|, so δ and h are fractions), fed each period's value as it is (`median = 1`,
@@ -46,6 +47,9 @@ struct DriftSettings {
 
 struct AlarmSettings {
   std::vector<Threshold> thresholds;
+  /// no threshold event before this long after the first estimate [s]: the first seconds'
+  /// estimates rest on a few hundred samples (docs/monitor.md, "Events")
+  double warmup_s = 8.0;
   DriftSettings drift;
 };
 
