@@ -25,6 +25,13 @@ std::string canonical(std::string p) {
   return p;
 }
 
+/// A warm-up key (`[alarms]` or `[drift]` `warmup_s`) [s]: `fallback` when absent; InputError
+/// naming it unless finite and ≥ 0.
+double read_warmup(TomlTable& t, double fallback) {
+  const double v = t.number_or("warmup_s", fallback);
+  if (!(v >= 0) || !std::isfinite(v)) t.fail("warmup_s", "must be finite and >= 0");
+  return v;
+}
 }  // namespace
 
 AlarmSettings read_alarm_settings(TomlTable& t) {
@@ -37,8 +44,7 @@ AlarmSettings read_alarm_settings(TomlTable& t) {
     for (const auto& [key, node] : *raw) {
       const std::string k(key.str());
       if (k == "warmup_s") {
-        s.warmup_s = a->number(k);
-        if (!(s.warmup_s >= 0) || !std::isfinite(s.warmup_s)) a->fail(k, "must be finite and >= 0");
+        s.warmup_s = read_warmup(*a, s.warmup_s);
         continue;
       }
       const bool is_max = k.size() > 4 && k.compare(k.size() - 4, 4, "_max") == 0;
@@ -63,7 +69,7 @@ AlarmSettings read_alarm_settings(TomlTable& t) {
     if (auto b = d->boolean_opt("enabled")) s.drift.enabled = *b;
     s.drift.delta = d->number_or("delta", s.drift.delta);
     s.drift.threshold = d->number_or("threshold", s.drift.threshold);
-    s.drift.warmup_s = d->number_or("warmup_s", s.drift.warmup_s);
+    s.drift.warmup_s = read_warmup(*d, s.drift.warmup_s);
     if (d->has("median")) {
       const double m = d->number("median");
       if (!(m >= 1 && m <= static_cast<double>(DriftSettings::kMaxMedian)) || m != std::floor(m))
@@ -82,7 +88,6 @@ AlarmSettings read_alarm_settings(TomlTable& t) {
     } catch (const std::invalid_argument& e) {
       d->fail(std::string(e.what()).rfind("delta", 0) == 0 ? "delta" : "threshold", e.what());
     }
-    if (!(s.drift.warmup_s >= 0) || !std::isfinite(s.drift.warmup_s)) d->fail("warmup_s", "must be finite and >= 0");
     d->finish();
   }
   return s;
