@@ -159,8 +159,10 @@ void add_intervals(EstimationRun& run, const EstimatorConfig& cfg, const RecordC
   const PerSide<SideParams> est{run.report.right.params, run.report.left.params};
   // model switching with λ = 1: its sides are often driven beyond the edge too seldom for a
   // section's estimate, and the estimate is a smooth function of sums over the samples
-  attach_intervals(run.report, cfg.model_switching && cfg.rls.lambda == 1.0 ? jackknife_intervals(cfg, rec, est, s)
-                                                                             : batch_means_intervals(cfg, rec, est, s));
+  attach_intervals(run.report,
+                   cfg.model_switching && cfg.rls.lambda == 1.0 ? jackknife_intervals(cfg, rec, est, s)
+                                                                : batch_means_intervals(cfg, rec, est, s),
+                   cfg.ci_tolerance);
 }
 
 void add_intervals(EstimationRun& run, const EstimatorConfig& cfg, std::span<const double> v,
@@ -168,13 +170,15 @@ void add_intervals(EstimationRun& run, const EstimatorConfig& cfg, std::span<con
   add_intervals(run, cfg, RecordColumns::of(v, y), gap_rows);
 }
 
-void attach_intervals(EstimateReport& rep, const PerSide<SideIntervals>& ci) {
+void attach_intervals(EstimateReport& rep, const PerSide<SideIntervals>& ci, double ci_tolerance) {
   const bool two = model_traits(rep.model).two_sided;
   for (const Side s : {Side::right, Side::left}) {
     SideReport& r = rep[s];
     if (!r.params.identified) continue;
     r.ci95 = ci[s];
-    if (interval_verdict(ci[s], s) == Reason::none) continue;
+    if (interval_verdict(ci[s], s) == Reason::none &&
+        precision_verdict(ci[s], ci_tolerance, rep.has_c, rep.has_side_d || rep.has_shared_d) == Reason::none)
+      continue;
     r.params.reason = Reason::uncertain;
     r.params.identified = false;
     if (s == Side::right || two) rep.identified = false;

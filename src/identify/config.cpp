@@ -61,6 +61,8 @@ void CommonSettings::validate() const {
   require(min_updates >= 1, "min-updates", "must be >= 1");
   require(std::isfinite(fit_threshold) && fit_threshold > 0, "fit-threshold", "must be > 0 (a fraction: 0.2 = 20 %)");
   require(std::isfinite(fit_start_s) && fit_start_s >= 0, "fit-start", "must be >= 0 [s]");
+  require(std::isfinite(ci_tolerance) && ci_tolerance >= 0, "ci-tolerance",
+          "must be >= 0 (a fraction: 0.05 = 5 %; 0 = off)");
 }
 
 void RegressionFilterSettings::validate() const {

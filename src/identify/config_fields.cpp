@@ -81,6 +81,9 @@ const ConfigField kFields[] = {
    kCommon, [](C& c) -> Ref { return &c.fit_threshold; }},
   {"", "fit_start", "", "Start of the verdict's fit window [s]", kCommon,
    [](C& c) -> Ref { return &c.fit_start_s; }},
+  {"", "ci_tolerance", "ci-tolerance",
+   "Identified only when each 95 % interval of K, tau, c, d lies within +-this fraction of its centre (0 = off)",
+   kCommon, [](C& c) -> Ref { return &c.ci_tolerance; }},
   // CommonSettings::rls
   {"rls", "lambda", "lambda", "Forgetting factor in [0.9, 1] (thesis: 0.99)", kCommon,
    [](C& c) -> Ref { return &c.rls.lambda; }},

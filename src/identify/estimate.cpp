@@ -140,7 +140,7 @@ ArrayEstimate estimate_record(const SettingsSources& src, const RecordColumns& r
   out.estimator_cpu_s = thread_cpu_s() - cpu_start;
   out.estimator_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   if (o.intervals && out.run.ci95)  // computed while checking the ẏ result: the same estimate, settings, record
-    attach_intervals(out.run.run.report, *out.run.ci95);
+    attach_intervals(out.run.run.report, *out.run.ci95, out.run.cfg.ci_tolerance);
   else if (o.intervals)
     add_intervals(out.run.run, out.run.cfg, rec, smp.gap_rows);
   scored.report = out.run.run.report;

@@ -98,6 +98,8 @@ std::string estimate_text(const EstimateReport& r, double dt_s, const ReportFit&
       if (r.has_side_d) ci += "  d " + sig(s.ci95.d);
       ci += "  K " + sig(s.ci95.K) + "  tau " + sig(s.ci95.tau_s);
       out += ci + "\n";
+    } else if (s.params.reason == Reason::uncertain) {  // check 8 without intervals
+      out += "        95 %: none (too few sections identify this side: its precision is unknown)\n";
     }
   };
   if (r.model == ModelKind::linear) show("model", r.right);

@@ -23,6 +23,13 @@ Reason interval_verdict(const SideIntervals& ci, Side s) noexcept {
   return impossible ? Reason::uncertain : Reason::none;
 }
 
+Reason precision_verdict(const SideIntervals& ci, double tolerance, bool has_c, bool has_d) noexcept {
+  if (!(tolerance > 0.0)) return Reason::none;
+  auto tight = [tolerance](const Interval& i) { return i.valid() && i.hi - i.lo <= tolerance * std::fabs(i.hi + i.lo); };
+  const bool ok = tight(ci.K) && tight(ci.tau_s) && (!has_c || tight(ci.c)) && (!has_d || tight(ci.d));
+  return ok ? Reason::none : Reason::uncertain;
+}
+
 double student_t975(std::size_t dof) noexcept {
   // t_{0.975, n}, n = 1 … 30 (any statistics table; scipy.stats.t.ppf(0.975, n))
   static constexpr std::array<double, 30> t{12.7062047, 4.30265273, 3.18244631, 2.77644511, 2.57058184, 2.44691185,

@@ -199,11 +199,14 @@ std::optional<OnlineSnapshot> OnlineEstimator::snapshot(double t_from, double t_
     rep.identified = rep.right.params.identified && (!two || rep.left.params.identified) &&
                      (!rep.has_shared_d || rep.d_reason == Reason::none);
   }
-  if (sections_.size() >= s_.min_sections) {
-    const std::vector<PerSide<SideParams>> secs(sections_.begin(), sections_.end());
-    const auto ci = section_intervals(ar.cfg, secs, sec_len_, static_cast<std::size_t>(fed_),
-                                      {rep.right.params, rep.left.params}, s_.min_sections);
-    attach_intervals(rep, ci);
+  {  // too few sections yet: no intervals (checks 7 and 8 see invalid ones)
+    PerSide<SideIntervals> ci{};
+    if (sections_.size() >= s_.min_sections) {
+      const std::vector<PerSide<SideParams>> secs(sections_.begin(), sections_.end());
+      ci = section_intervals(ar.cfg, secs, sec_len_, static_cast<std::size_t>(fed_),
+                             {rep.right.params, rep.left.params}, s_.min_sections);
+    }
+    attach_intervals(rep, ci, ar.cfg.ci_tolerance);
   }
   if (uses_guesses_) {
     for (const auto& [side, g, source] : {std::tuple{Side::right, &ar.right, src_r_}, std::tuple{Side::left, &ar.left, src_l_}}) {

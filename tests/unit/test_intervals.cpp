@@ -131,3 +131,70 @@ TEST(Intervals, AttachMarksTheUncertainSide) {
   EXPECT_TRUE(lin.identified);
   EXPECT_FALSE(lin.left.ci95.K.valid());
 }
+
+// Verdict check 8 (precision_verdict, `ci_tolerance`): by hand, (hi - lo) / |hi + lo| against
+// the tolerance for K, tau, c and d; a1 and b1 are not judged; a missing interval fails.
+TEST(Intervals, PrecisionVerdictJudgesTheHalfWidthAgainstTheTolerance) {
+  using lash::Reason;
+  lash::SideIntervals ci;
+  ci.a1 = {-1.5, 0.5};      // not judged (K and tau are)
+  ci.b1 = {-0.1, 0.3};      // not judged
+  ci.K = {1.9, 2.1};        // half-width 0.1 of centre 2: 5 %
+  ci.tau_s = {0.098, 0.102};  // 2 %
+  ci.c = {190.0, 210.0};    // 5 %
+  ci.d = {29.7, 30.3};      // 1 %
+  const auto v = [&](double tol, bool has_c = true, bool has_d = true) {
+    return lash::precision_verdict(ci, tol, has_c, has_d);
+  };
+  EXPECT_EQ(v(0.0), Reason::none);    // off
+  EXPECT_EQ(v(-1.0), Reason::none);   // off
+  EXPECT_EQ(v(0.051), Reason::none);  // K and c at 5 % pass 5.1 %
+  EXPECT_EQ(v(0.049), Reason::uncertain);
+  ci.K = {1.95, 2.05};                // 2.5 %: now c (5 %) decides
+  EXPECT_EQ(v(0.049), Reason::uncertain);
+  EXPECT_EQ(v(0.049, false), Reason::none);  // a model without c: c not judged
+  EXPECT_EQ(v(0.021, false), Reason::uncertain);  // K 2.5 % > 2.1 %
+  ci.d = {};                          // no d interval
+  EXPECT_EQ(v(0.03, false, false), Reason::none);
+  EXPECT_EQ(v(0.03, false, true), Reason::uncertain);  // the model has d: missing fails
+  ci.tau_s = {-0.05, 0.05};           // centre 0: never within a tolerance
+  EXPECT_EQ(v(100.0, false, false), Reason::uncertain);
+  EXPECT_EQ(lash::precision_verdict(lash::SideIntervals{}, 0.5, false, false), Reason::uncertain);
+}
+
+// attach_intervals with a tolerance: no intervals at all (too few sections) is `uncertain`;
+// without a tolerance it changes nothing.
+TEST(Intervals, AttachWithAToleranceNeedsIntervals) {
+  const auto report = [] {
+    lash::EstimateReport rep;
+    rep.model = lash::ModelKind::input_deadzone;
+    rep.has_c = true;
+    rep.identified = true;
+    for (lash::SideReport* s : {&rep.right, &rep.left}) {
+      s->params.identified = true;
+      s->params.reason = lash::Reason::none;
+    }
+    return rep;
+  };
+  lash::PerSide<lash::SideIntervals> none{};
+  lash::EstimateReport a = report();
+  lash::attach_intervals(a, none);
+  EXPECT_TRUE(a.identified);
+  lash::attach_intervals(a, none, 0.05);
+  EXPECT_FALSE(a.identified);
+  EXPECT_EQ(a.right.params.reason, lash::Reason::uncertain);
+  EXPECT_EQ(a.left.params.reason, lash::Reason::uncertain);
+  lash::PerSide<lash::SideIntervals> ci{};
+  ci.right.K = {1.9, 2.1};
+  ci.right.tau_s = {0.099, 0.101};
+  ci.right.c = {195.0, 205.0};
+  ci.left = ci.right;
+  ci.left.c = {-230.0, -170.0};  // 15 %
+  lash::EstimateReport b = report();
+  lash::attach_intervals(b, ci, 0.1);
+  EXPECT_TRUE(b.right.params.identified);
+  EXPECT_FALSE(b.left.params.identified);
+  EXPECT_EQ(b.left.params.reason, lash::Reason::uncertain);
+  EXPECT_EQ(b.left.ci95.c.lo, -230.0);  // kept, to show why
+  EXPECT_FALSE(b.identified);
+}

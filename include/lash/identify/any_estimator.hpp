@@ -252,9 +252,11 @@ void add_intervals(EstimationRun& run, const EstimatorConfig& cfg, const RecordC
                    std::span<const std::size_t> gap_rows = {});
 void add_intervals(EstimationRun& run, const EstimatorConfig& cfg, std::span<const double> v,
                    std::span<const double> y, std::span<const std::size_t> gap_rows = {});
-/// Sets the 95 % intervals ci on the identified sides of rep and applies verdict check 7
-/// (interval_verdict): a side whose interval reaches a physically impossible value becomes
-/// `uncertain` (not identified; its intervals kept, to show why), and so does the model.
-void attach_intervals(EstimateReport& rep, const PerSide<SideIntervals>& ci);
+/// Sets the 95 % intervals ci on the identified sides of rep and applies verdict checks 7
+/// (interval_verdict) and 8 (precision_verdict with `ci_tolerance`; ci may be all invalid: no
+/// intervals could be computed): a side whose interval reaches a physically impossible value, or
+/// is missing or wider than the tolerance, becomes `uncertain` (not identified; its intervals
+/// kept, to show why), and so does the model.
+void attach_intervals(EstimateReport& rep, const PerSide<SideIntervals>& ci, double ci_tolerance = 0.0);
 
 }  // namespace lash

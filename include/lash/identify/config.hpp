@@ -108,6 +108,11 @@ struct CommonSettings {
   /// Start of the verdict's fit window [s] (the whole record when it ends earlier); 7.5 s is
   /// the thesis's NRMSE window start and `lash estimate`'s default --nrmse-window.
   double fit_start_s = 7.5;
+  /// Verdict check 8 (verdict.hpp), off at 0: where 95 % intervals are computed, a side is
+  /// identified only when it has them and each of its K, τ, c and d intervals lies within
+  /// ±ci_tolerance of its centre (0.05 = 5 %) — else `uncertain`. Turns "identified" into
+  /// "known to this precision": the user's tolerance, not a property of the data.
+  double ci_tolerance = 0.0;
   static constexpr ModelSet models = kAllModels;
   void validate() const;
 };

@@ -83,6 +83,13 @@ PerSide<SideIntervals> section_intervals(const EstimatorConfig& cfg, std::span<c
 /// spans zero while its K interval is 1.25–3.04; the physical quantity is K).
 Reason interval_verdict(const SideIntervals& ci, Side s) noexcept;
 
+/// Check 8 of verdict.hpp (`ci_tolerance` > 0): Reason::uncertain unless the K and τ intervals
+/// and, where the model has them (`has_c`, `has_d`), the c and d intervals are all computed and
+/// each half-width is at most `tolerance` × |its centre| ((hi − lo) / |hi + lo| ≤ tolerance) —
+/// else Reason::none. K and τ, not a1 and b1: they are the physical quantities, and a1 near −1
+/// hides a loose τ (a1 = −0.99 ± 1 % is τ from 0.5 to ∞ at 5 ms). tolerance ≤ 0: none.
+Reason precision_verdict(const SideIntervals& ci, double tolerance, bool has_c, bool has_d) noexcept;
+
 /// Student's t quantile t_{0.975, dof} for dof ≥ 1 (table to 30, then the normal-limit series).
 double student_t975(std::size_t dof) noexcept;
 

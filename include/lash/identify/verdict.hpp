@@ -22,7 +22,10 @@
 ///     `fit_threshold` (checked by `verdict()`) — else `poor_fit`;
 ///  7. where 95 % intervals were computed (`lash estimate`, the monitor; intervals.hpp), none of
 ///     them reaches a physically impossible value (a1 < 0 and τ > 0; K > 0; the
-///     edge on its own side of zero; d ≥ 0) — else `uncertain` (interval_verdict).
+///     edge on its own side of zero; d ≥ 0) — else `uncertain` (interval_verdict);
+///  8. only with `ci_tolerance` > 0 (config.hpp; off by default), where intervals are computed:
+///     the side has intervals, and those of K, τ, c and d each lie within ±ci_tolerance of their
+///     centre — else `uncertain` (precision_verdict).
 #include <array>
 #include <cmath>
 #include <cstddef>
