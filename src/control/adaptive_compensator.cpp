@@ -190,7 +190,7 @@ PerSide<GateInput> DeadzoneAdapter::step(double v_applied, double y, const PerSi
   for (const Side s : {Side::right, Side::left}) {
     if (!moved[s]) [[likely]]
       continue;
-    (s == Side::right ? ecfg_.guess_right : ecfg_.guess_left) = rg_.guess(s);
+    ecfg_.guess(s) = rg_.guess(s);
     const double lambda = exc_[s].lambda;
     exc_[s] = detail::Excitation{};
     exc_[s].lambda = lambda;

@@ -555,12 +555,12 @@ AutoRun estimate_auto(const EstimatorConfig& cfg0, const RecordColumns& rec, con
   if (out.switching.used) {
     out.right.edge = out.left.edge = detail::kNaN;
   } else if (uses_guesses(cfg.model)) {
-    out.right.guess = cfg.guess_right;
-    out.left.guess = cfg.guess_left;
-    out.right.source = search_r ? GuessSource::searched : GuessSource::given;
-    out.left.source = search_l ? GuessSource::searched : GuessSource::given;
-    out.right.wrong_side = std::isfinite(out.right.edge) && out.right.edge >= cfg.guess_right;
-    out.left.wrong_side = std::isfinite(out.left.edge) && out.left.edge <= cfg.guess_left;
+    for (const auto& [s, searched] : {std::pair{Side::right, search_r}, std::pair{Side::left, search_l}}) {
+      GuessReport& g = out.guess(s);
+      g.guess = cfg.guess(s);
+      g.source = searched ? GuessSource::searched : GuessSource::given;
+      g.judge(s);
+    }
   }
   return out;
 }

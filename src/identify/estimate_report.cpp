@@ -123,7 +123,7 @@ SideAdvice side_advice(const AutoRun& ar, Side s, const DataTraits* traits) {
       r.model != ModelKind::deadzone_deadband)
     return a;
   const SideReport& sr = r[s];
-  const GuessReport& g = s == Side::right ? ar.right : ar.left;
+  const GuessReport& g = ar.guess(s);
   const Reason why = g.wrong_side ? Reason::wrong_guess : sr.params.reason;
   if (why != Reason::not_updated && why != Reason::not_excited && why != Reason::wrong_guess) return a;
   a.given = true;

@@ -209,11 +209,12 @@ std::optional<OnlineSnapshot> OnlineEstimator::snapshot(double t_from, double t_
     attach_intervals(rep, ci, ar.cfg.ci_tolerance);
   }
   if (uses_guesses_) {
-    for (const auto& [side, g, source] : {std::tuple{Side::right, &ar.right, src_r_}, std::tuple{Side::left, &ar.left, src_l_}}) {
-      g->guess = side == Side::right ? ar.cfg.guess_right : ar.cfg.guess_left;
-      g->source = source;
-      g->edge = e.raw_edge(side);
-      g->wrong_side = std::isfinite(g->edge) && (side == Side::right ? g->edge >= g->guess : g->edge <= g->guess);
+    for (const auto& [side, source] : {std::pair{Side::right, src_r_}, std::pair{Side::left, src_l_}}) {
+      GuessReport& g = ar.guess(side);
+      g.guess = ar.cfg.guess(side);
+      g.source = source;
+      g.edge = e.raw_edge(side);
+      g.judge(side);
     }
   }
   ar.outliers = outliers_;

@@ -518,7 +518,7 @@ class DeadzoneAdapter {
   /// Re-guesses of side s so far (identify/reguess.hpp), and the side's guess now [mA].
   std::uint64_t reguesses(Side s) const noexcept { return rg_.count(s); }
   const SideReguess& reguess(Side s) const noexcept { return rg_.side(s); }
-  double guess(Side s) const noexcept { return s == Side::right ? ecfg_.guess_right : ecfg_.guess_left; }
+  double guess(Side s) const noexcept { return ecfg_.guess(s); }
   /// A gap: the estimator's restart(); the excitation record skips the samples the estimator
   /// does not update on (its warm-up), as it skips those inside the guesses.
   void restart() noexcept {

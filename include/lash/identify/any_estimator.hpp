@@ -94,7 +94,7 @@ class AnyEstimator {
   /// Sets side s's switching guess and starts that side's recursion anew (estimator_skeleton.hpp).
   void set_guess(Side s, double guess) noexcept {
     std::visit([s, guess](auto& e) noexcept { e.set_guess(s, guess); }, e_);
-    (s == Side::right ? cfg_.guess_right : cfg_.guess_left) = guess;
+    cfg_.guess(s) = guess;
   }
   /// The deadzone edge side s's regression points at, identified or not (NaN when none).
   double raw_edge(Side s) const noexcept {

@@ -10,6 +10,7 @@
 ///    against the identified edge (wrong side = `wrong_guess`).
 /// Not real-time safe (allocates, runs whole records). The sample path stays in the estimators.
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -75,6 +76,8 @@ struct GuessReport {
   /// the deadzone, the side's regressions mixed samples of two regimes (`reason: wrong_guess`).
   bool wrong_side = false;
   double edge = 0.0;           ///< the edge the check used [v unit] (NaN: none)
+  /// Sets wrong_side from edge and guess for side s.
+  void judge(Side s) noexcept { wrong_side = std::isfinite(edge) && (s == Side::right ? edge >= guess : edge <= guess); }
 };
 
 /// Why estimate_auto ran model switching (docs/method.md §A4.4b).
@@ -108,6 +111,8 @@ struct AutoRun {
   SwitchingReport switching;
   EstimationRun run;
   GuessReport right, left;
+  GuessReport& guess(Side s) noexcept { return s == Side::right ? right : left; }
+  const GuessReport& guess(Side s) const noexcept { return s == Side::right ? right : left; }
   std::uint64_t outliers = 0;  ///< samples of y the outlier gate replaced (auto_gate.hpp)
   /// The batch-means intervals of the final run's estimate when estimate_auto computed them
   /// already (the check of a ẏ result, SwitchingReport::trigger): add_intervals need not run again.

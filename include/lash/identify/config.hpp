@@ -132,6 +132,9 @@ struct InputSwitchingSettings {
   /// Free-run simulation inside the input deadzone: false = keep the a1 of the side last used
   /// (thesis §1.4.2, docs/method.md §A4.2); true = side by the sign of v(k−1) (eq. 34).
   bool sim_side_by_sign = false;
+  /// The guess of side s (guess_right or guess_left).
+  double& guess(Side s) noexcept { return s == Side::right ? guess_right : guess_left; }
+  double guess(Side s) const noexcept { return s == Side::right ? guess_right : guess_left; }
   static constexpr ModelSet models =
       model_bit(ModelKind::input_deadzone) | model_bit(ModelKind::deadzone_deadband);
   void validate() const;

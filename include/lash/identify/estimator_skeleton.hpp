@@ -260,7 +260,7 @@ class SwitchingEstimator : public Model {
   /// history. Models that do not switch on the guesses (traits.uses_guesses false) only store
   /// the value. noexcept, allocation-free.
   void set_guess(Side s, double guess) noexcept {
-    (s == Side::right ? c_.cfg.guess_right : c_.cfg.guess_left) = guess;
+    c_.cfg.guess(s) = guess;
     if constexpr (traits.uses_guesses) {
       c_.vrange[s] = {};
       c_.yrange[s] = {};

@@ -286,7 +286,7 @@ void DeadzoneDeadbandModel::restart_side(EstimatorCore& c, Side s) noexcept {
   beyond_[s] = 0;
   usable_[s] = false;
   sim_[s] = {};  // no output from that side until its new estimate is usable
-  sc_[s] = s == Side::right ? c.cfg.guess_right : c.cfg.guess_left;
+  sc_[s] = c.cfg.guess(s);
   prev_c_[s] = prev_d_[s] = 0.0;
   settled_[s] = since_[s] = 0;
 }

@@ -51,7 +51,7 @@ void InputDeadzoneModel::free_run(EstimatorCore& c) noexcept {
 void InputDeadzoneModel::restart_side(EstimatorCore& c, Side s) noexcept {
   rls_[s].reset();
   sa1_[s] = sb1_[s] = 0.0;  // no output from that side until its new estimate is simulable
-  sc_[s] = s == Side::right ? c.cfg.guess_right : c.cfg.guess_left;
+  sc_[s] = c.cfg.guess(s);
 }
 
 template class SwitchingEstimator<InputDeadzoneModel>;
