@@ -99,7 +99,7 @@ std::string estimate_text(const EstimateReport& r, double dt_s, const ReportFit&
       ci += "  K " + sig(s.ci95.K) + "  tau " + sig(s.ci95.tau_s);
       out += ci + "\n";
     } else if (s.params.reason == Reason::uncertain) {  // check 8 without intervals
-      out += "        95 %: none (too few sections identify this side: its precision is unknown)\n";
+      out += "        95 %: none (too few sections identify this side)\n";
     }
   };
   if (r.model == ModelKind::linear) show("model", r.right);
@@ -125,6 +125,30 @@ SideAdvice side_advice(const AutoRun& ar, Side s, const DataTraits* traits) {
   const SideReport& sr = r[s];
   const GuessReport& g = ar.guess(s);
   const Reason why = g.wrong_side ? Reason::wrong_guess : sr.params.reason;
+  const char* side = s == Side::right ? "right" : "left";
+  if (why == Reason::uncertain && ar.cfg.ci_tolerance > 0.0 &&
+      interval_verdict(sr.ci95, s) == Reason::none) {  // check 8 failed, not check 7
+    const WidestInterval w = widest_interval(sr.ci95, r.has_c, r.has_side_d || r.has_shared_d);
+    if (!w.name) return a;
+    a.given = true;
+    a.widest = w.name;
+    a.widest_relative = w.relative;
+    const double tol = ar.cfg.ci_tolerance, record_s = static_cast<double>(r.samples) * ar.cfg.dt_s;
+    if (!std::isfinite(w.relative)) {
+      a.text = fmt::format("{} side: no 95 % interval (fewer than 5 of the 10 sections identify it), so its precision "
+                           "is unknown against --ci-tolerance {:.6g} %; record longer, driving the side beyond its "
+                           "edge in every tenth of the record",
+                           side, 100.0 * tol);
+      return a;
+    }
+    // an interval's half-width falls as 1/sqrt(the record's length) for the same input and noise
+    a.record_s_needed = record_s * (w.relative / tol) * (w.relative / tol);
+    a.text = fmt::format("{} side: the 95 % interval of {} is +-{:.3g} % of its centre, wider than --ci-tolerance "
+                         "{:.6g} %; intervals narrow as 1/sqrt(length): about {:.3g} s of the same input (this "
+                         "record: {:.3g} s), or less noise",
+                         side, w.name, 100.0 * w.relative, 100.0 * tol, a.record_s_needed, record_s);
+    return a;
+  }
   if (why != Reason::not_updated && why != Reason::not_excited && why != Reason::wrong_guess) return a;
   a.given = true;
   a.by_direction = model_traits(r.model).keys_by_direction;
@@ -181,7 +205,6 @@ SideAdvice side_advice(const AutoRun& ar, Side s, const DataTraits* traits) {
     a.drive_left = 2.0 * a.excite_left;
     a.drive_right = 2.0 * a.excite_right;
   }
-  const char* side = s == Side::right ? "right" : "left";
   const std::string where = std::isfinite(a.beyond) ? fmt::format(" beyond {:+.6g}", a.beyond) : std::string();
   const auto count = [](std::uint64_t n) { return n == 0 ? std::string("none") : fmt::format("{}", n); };
   std::string t = fmt::format("{} side: ", side);
@@ -235,6 +258,12 @@ std::string estimate_auto_json(const AutoRun& ar, Preset preset, const ReportFit
     }
     Json o;
     o["text"] = a.text;
+    if (!a.widest.empty()) {  // check 8: precision, not updates
+      o["widest_interval"] = {{"parameter", a.widest}, {"relative_half_width", num(a.widest_relative)},
+                              {"record_s_needed", num(a.record_s_needed)}};
+      j[side]["advice"] = o;
+      return;
+    }
     if (a.by_direction) {
       o["updates_up"] = a.up;
       o["updates_down"] = a.down;

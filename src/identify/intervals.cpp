@@ -23,11 +23,24 @@ Reason interval_verdict(const SideIntervals& ci, Side s) noexcept {
   return impossible ? Reason::uncertain : Reason::none;
 }
 
+WidestInterval widest_interval(const SideIntervals& ci, bool has_c, bool has_d) noexcept {
+  WidestInterval w;
+  const auto judge = [&w](const char* name, const Interval& i) {
+    if (w.relative == std::numeric_limits<double>::infinity()) return;  // the first missing one stays
+    const double rel = i.valid() && i.hi + i.lo != 0.0 ? (i.hi - i.lo) / std::fabs(i.hi + i.lo)
+                                                       : std::numeric_limits<double>::infinity();
+    if (!w.name || rel > w.relative) w = {name, rel};
+  };
+  judge("K", ci.K);
+  judge("tau_s", ci.tau_s);
+  if (has_c) judge("c", ci.c);
+  if (has_d) judge("d", ci.d);
+  return w;
+}
+
 Reason precision_verdict(const SideIntervals& ci, double tolerance, bool has_c, bool has_d) noexcept {
   if (!(tolerance > 0.0)) return Reason::none;
-  auto tight = [tolerance](const Interval& i) { return i.valid() && i.hi - i.lo <= tolerance * std::fabs(i.hi + i.lo); };
-  const bool ok = tight(ci.K) && tight(ci.tau_s) && (!has_c || tight(ci.c)) && (!has_d || tight(ci.d));
-  return ok ? Reason::none : Reason::uncertain;
+  return widest_interval(ci, has_c, has_d).relative <= tolerance ? Reason::none : Reason::uncertain;
 }
 
 double student_t975(std::size_t dof) noexcept {

@@ -3,6 +3,7 @@
 // a reason that is not the input's gets none.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -87,4 +88,49 @@ TEST(Advice, OnlyForTheInputsReasons) {
   AutoRun lin = run_with(Reason::not_updated, 0, 0);
   lin.run.report.model = ModelKind::linear;
   EXPECT_FALSE(side_advice(lin, Side::right).given);
+}
+
+// Check 8 (ci_tolerance): the advice names the widest judged interval, its half-width over its
+// centre, and the record length that would narrow it to the tolerance, (w / tol)^2 x the record
+// (intervals narrow as 1/sqrt(length)); by hand: d [28, 32] is 2/30 = 6.667 %, K [2.45, 2.55]
+// 2 %, tau 1 %, c 0.5 %; 40 000 samples of 5 ms = 200 s -> 200 x (6.667/5)^2 = 355.6 s.
+TEST(Advice, PrecisionNamesTheWidestInterval) {
+  AutoRun ar = run_with(Reason::uncertain, 900, 900);
+  ar.cfg.ci_tolerance = 0.05;
+  ar.run.report.samples = 40000;
+  SideIntervals& ci = ar.run.report.right.ci95;
+  ci.K = {2.45, 2.55};
+  ci.tau_s = {0.099, 0.101};
+  ci.c = {199.0, 201.0};
+  ci.d = {28.0, 32.0};
+  const WidestInterval w = widest_interval(ci, true, true);
+  EXPECT_STREQ(w.name, "d");
+  EXPECT_NEAR(w.relative, 2.0 / 30.0, 1e-12);
+  const SideAdvice a = side_advice(ar, Side::right);
+  ASSERT_TRUE(a.given);
+  EXPECT_EQ(a.widest, "d");
+  EXPECT_NEAR(a.record_s_needed, 200.0 * (2.0 / 30.0 / 0.05) * (2.0 / 30.0 / 0.05), 1e-9);
+  EXPECT_NE(a.text.find("right side: the 95 % interval of d is +-6.67 % of its centre, wider than --ci-tolerance 5 %"),
+            std::string::npos)
+      << a.text;
+  EXPECT_NE(a.text.find("about 356 s of the same input (this record: 200 s)"), std::string::npos) << a.text;
+  const auto j = nlohmann::json::parse(estimate_auto_json(ar, Preset::lash, ReportFit{}));
+  EXPECT_EQ(j["right"]["advice"]["widest_interval"]["parameter"], "d");
+  EXPECT_NEAR(j["right"]["advice"]["widest_interval"]["record_s_needed"].get<double>(), a.record_s_needed, 1e-9);
+  // no interval computed: named as such, no length suggested
+  ar.run.report.right.ci95 = {};
+  const SideAdvice n = side_advice(ar, Side::right);
+  ASSERT_TRUE(n.given);
+  EXPECT_EQ(n.widest, "K");  // the first missing one
+  EXPECT_TRUE(std::isinf(n.widest_relative));
+  EXPECT_TRUE(std::isnan(n.record_s_needed));
+  EXPECT_NE(n.text.find("right side: no 95 % interval"), std::string::npos) << n.text;
+  // check 7 (an impossible value) is not a precision matter: no advice
+  ar.run.report.right.ci95 = ci;
+  ar.run.report.right.ci95.d = {-1.0, 3.0};
+  EXPECT_FALSE(side_advice(ar, Side::right).given);
+  // without a tolerance an uncertain side gets none (check 7's)
+  ar.cfg.ci_tolerance = 0.0;
+  ar.run.report.right.ci95 = ci;
+  EXPECT_FALSE(side_advice(ar, Side::right).given);
 }

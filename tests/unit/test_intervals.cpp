@@ -198,3 +198,25 @@ TEST(Intervals, AttachWithAToleranceNeedsIntervals) {
   EXPECT_EQ(b.left.ci95.c.lo, -230.0);  // kept, to show why
   EXPECT_FALSE(b.identified);
 }
+
+// widest_interval by hand: the judged interval widest against its centre.
+TEST(Intervals, WidestIntervalByHand) {
+  lash::SideIntervals ci;
+  ci.K = {1.8, 2.2};     // 10 %
+  ci.tau_s = {0.09, 0.11};  // 10 % (not wider: K, first, stays)
+  ci.c = {-210.0, -190.0};  // 5 %
+  ci.d = {9.0, 11.0};    // 10 %
+  auto w = lash::widest_interval(ci, true, true);
+  EXPECT_STREQ(w.name, "K");
+  EXPECT_NEAR(w.relative, 0.1, 1e-12);
+  ci.c = {-260.0, -140.0};  // 30 %
+  w = lash::widest_interval(ci, true, true);
+  EXPECT_STREQ(w.name, "c");
+  EXPECT_NEAR(w.relative, 0.3, 1e-12);
+  w = lash::widest_interval(ci, false, true);  // no c in the model
+  EXPECT_STREQ(w.name, "K");
+  ci.tau_s = {};
+  w = lash::widest_interval(ci, true, true);
+  EXPECT_STREQ(w.name, "tau_s");
+  EXPECT_TRUE(std::isinf(w.relative));
+}

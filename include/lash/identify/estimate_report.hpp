@@ -57,6 +57,12 @@ struct SideAdvice {
   bool from_input = false;
   double dt_s = 0.0;              ///< the record's sample period (for the `lash excite` line)
   double excite_duration_s = 0.0; ///< the duration suggested for `lash excite` [s]
+  /// `uncertain` by check 8 (ci_tolerance): the widest judged interval (widest_interval), its
+  /// half-width over its centre (+inf: not computed) and the record length [s] that would
+  /// narrow it to the tolerance at the same input and noise (intervals narrow as 1/√length).
+  std::string widest;
+  double widest_relative = std::numeric_limits<double>::quiet_NaN();
+  double record_s_needed = std::numeric_limits<double>::quiet_NaN();
 };
 /// The `lash excite --duration` the advice suggests [s]: the default sine identified the
 /// deadzone-deadband model within 5 % in about half of it (docs/excite.md).

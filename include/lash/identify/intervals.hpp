@@ -90,6 +90,15 @@ Reason interval_verdict(const SideIntervals& ci, Side s) noexcept;
 /// hides a loose τ (a1 = −0.99 ± 1 % is τ from 0.5 to ∞ at 5 ms). tolerance ≤ 0: none.
 Reason precision_verdict(const SideIntervals& ci, double tolerance, bool has_c, bool has_d) noexcept;
 
+/// The interval check 8 judges that is widest relative to its centre: its name ("K", "tau_s",
+/// "c", "d") and (hi − lo) / |hi + lo| (+inf when one of them was not computed, name = the first
+/// missing; name nullptr when there is nothing to judge).
+struct WidestInterval {
+  const char* name = nullptr;
+  double relative = 0.0;
+};
+WidestInterval widest_interval(const SideIntervals& ci, bool has_c, bool has_d) noexcept;
+
 /// Student's t quantile t_{0.975, dof} for dof ≥ 1 (table to 30, then the normal-limit series).
 double student_t975(std::size_t dof) noexcept;
 
