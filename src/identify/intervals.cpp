@@ -25,8 +25,7 @@ Reason interval_verdict(const SideIntervals& ci, Side s) noexcept {
 
 WidestInterval widest_interval(const SideIntervals& ci, bool has_c, bool has_d) noexcept {
   WidestInterval w;
-  const auto judge = [&w](const char* name, const Interval& i) {
-    if (w.relative == std::numeric_limits<double>::infinity()) return;  // the first missing one stays
+  const auto judge = [&w](const char* name, const Interval& i) {  // strict >: the first missing one stays
     const double rel = i.valid() && i.hi + i.lo != 0.0 ? (i.hi - i.lo) / std::fabs(i.hi + i.lo)
                                                        : std::numeric_limits<double>::infinity();
     if (!w.name || rel > w.relative) w = {name, rel};
