@@ -7,8 +7,9 @@
    busy host; the master's TET mean with adaptation on is printed (a timing figure, not asserted);
  - a coupled_carts scenario, or --compensation without --scenario, is refused with exit 2;
  - the default `lash hil run --duration 5` (live, two processes in the run's own network
-   namespace): overshoot <= 10 % and, from 1 s after the step, the current's std <= 50 mA,
-   recomputed here from slave.csv / master.csv."""
+   namespace): equal to its observed-schedule simulation on every attempt; on an attempt with at
+   most 1 % of its steps off schedule and no degraded or safe-state episode, overshoot <= 10 % and,
+   from 1 s after the step, the current's std <= 50 mA, recomputed here from slave.csv / master.csv."""
 import json
 import os
 import statistics
@@ -171,14 +172,28 @@ for attempt in range(5):
     print(f"default attempt {attempt}: step {r0} -> {r1} kPa at {ts} s, overshoot {overshoot:.2f} % (report "
           f"{rep['step_response']['overshoot_pct']:.2f} %), current std from {ts + 1} s {sd:.2f} mA, off-schedule "
           f"{rep['off_schedule_steps']}")
-    if rep["off_schedule_steps"] == 0:
+    check(rep["max_abs_diff_vs_observed_schedule_kPa"] == 0,
+          f"default attempt {attempt}: hil run == its observed-schedule simulation "
+          f"({rep['max_abs_diff_vs_observed_schedule_kPa']} kPa)")
+    # As the drift part (c): a few late frames (<= 1 % of the 1000 steps) with no degraded or
+    # safe-state episode of either node while the loop ran hold the command for a step each;
+    # overshoot and the current's spread are judged on such a run with the same bounds (the late-
+    # frame study's RMS ratios 0.96..1.15 against the ideal schedule; the bounds are 15x and 6x
+    # the clean run's 0.67 % and 7.9 mA).
+    n_steps = rep["master"]["control_steps"]
+    episodes = [e["event"] for node in ("master", "slave") for e in rep[node]["events"]
+                if 1 < e["step"] <= n_steps and ("degraded" in e["event"] or "safe_state" in e["event"])]
+    if episodes:
+        print(f"default attempt {attempt}: not judged (degraded or safe-state episode: {episodes})")
+    if rep["off_schedule_steps"] <= n_steps // 100 and not episodes:
         clean_default = True
         check(r0 == 500 and r1 == 1500, "default reference: the 500 -> 1500 kPa step")
         check(overshoot <= 10.0, f"live default loop: overshoot {overshoot:.2f} % <= 10 %")
         check(sd <= 50.0, f"live default loop: current std {sd:.2f} mA <= 50 mA")
         break
 if not clean_default:
-    print("skip (live default loop): every attempt had off-schedule frames")
+    print("skip (live default loop): every attempt had more than 1 % of its steps off schedule or a degraded or "
+          "safe-state episode")
 
 for f in fail:
     print("FAIL", f)
