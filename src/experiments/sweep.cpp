@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "lash/identify/auto.hpp"
+#include "lash/identify/intervals.hpp"
 #include "lash/metrics/error.hpp"
 #include "lash/metrics/first_order.hpp"
 #include "lash/metrics/fit.hpp"
@@ -188,6 +189,40 @@ EstimatorConfig settings_for(const Campaign& c, const RunSpec& r) {
   return e;
 }
 
+/// Verdict checks 7 and 8 (verdict.hpp), where the campaign's [estimator] sets ci_tolerance:
+/// the run's record again (the rig is deterministic in its seed; the estimator's own input),
+/// 95 % batch-means intervals around the identified sides (identify/intervals.hpp), and a side
+/// whose intervals hold an impossible value or are wider than ±ci_tolerance of their centres
+/// becomes `uncertain`; the coupled carts' d likewise, by its own interval. The sweep judges as
+/// `lash estimate --ci-tolerance` does.
+template <class Rig, class Measure>
+void judge_precision(const Campaign& c, const EstimatorConfig& ec, const RunSpec& r, Measure measure,
+                     RunResult& out) {
+  if (!(ec.ci_tolerance > 0.0)) return;
+  std::vector<double> v, y;
+  const RecordColumns rec = record_run<Rig>(c, r, measure, v, y);
+  const bool has_d = c.rig.kind == rigs::RigKind::coupled_carts;
+  PerSide<SideParams> p;
+  for (const Side s : {Side::right, Side::left}) {
+    const SideResult& q = out.side[s];
+    p[s] = {q.a1, q.b1, q.c, out.d, q.identified, q.identified ? Reason::none : Reason::not_updated};
+  }
+  const PerSide<SideIntervals> ci = batch_means_intervals(ec, rec, p);
+  for (const Side s : {Side::right, Side::left}) {
+    SideResult& q = out.side[s];
+    if (!q.identified) continue;
+    if (interval_verdict(ci[s], s) == Reason::none &&
+        precision_verdict(ci[s], ec.ci_tolerance, true, has_d) == Reason::none)
+      continue;
+    q.identified = false;
+    q.rejected = to_string(Reason::uncertain);
+  }
+  if (out.d_identified) {
+    const Interval& d = ci.right.d;
+    out.d_identified = d.valid() && d.hi - d.lo <= ec.ci_tolerance * std::fabs(d.hi + d.lo);
+  }
+}
+
 }  // namespace
 
 RunResult run_one(const Campaign& c, const RunSpec& r, const TraceFn& trace) {
@@ -198,11 +233,13 @@ RunResult run_one(const Campaign& c, const RunSpec& r, const TraceFn& trace) {
   score.k1 = std::min(n - 1, index_at(c.window_end_s, c.dt_s));
   const EstimatorConfig ec = settings_for(c, r);
   RunResult out;
+  const auto same = [](double y) { return std::pair<double, double>{y, y}; };
   switch (c.rig.kind) {
     case rigs::RigKind::motor_cart: {
       rigs::MotorCart rig(c.rig.motor_cart, c.dt_s, r.seed);
       out = run_deadzone_model(c, ec, r, rig, sig, n, score, trace);
       out.truth = rig.effective();
+      judge_precision<rigs::MotorCart>(c, ec, r, same, out);
       score_params(out, true);
       break;
     }
@@ -210,6 +247,7 @@ RunResult run_one(const Campaign& c, const RunSpec& r, const TraceFn& trace) {
       rigs::PilotValveRig rig(c.rig.pilot_valve, c.dt_s, r.seed);
       out = run_deadzone_model(c, ec, r, rig, sig, n, score, trace);
       out.truth = c.rig.pilot_valve.effective(c.dt_s, 0.0);
+      judge_precision<rigs::PilotValveRig>(c, ec, r, same, out);
       score_params(out, false);
       break;
     }
@@ -234,6 +272,7 @@ RunResult run_one(const Campaign& c, const RunSpec& r, const TraceFn& trace) {
       out.d = est.deadband();
       out.d_identified = est.deadband_reason() == Reason::none;
       out.truth = rig.effective();
+      judge_precision<rigs::CoupledCarts>(c, ec, r, pos_vel, out);
       score_params(out, true);
       break;
     }

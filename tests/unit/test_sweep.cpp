@@ -1,12 +1,15 @@
 // lash sweep library: scheduling does not change results, seeds differ per repeat, the NRMSE
 // window and the summary's counting are what docs/sweep.md says.
+#include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "lash/experiments/campaign.hpp"
 #include "lash/experiments/sweep.hpp"
+#include "lash/identify/intervals.hpp"
 
 using namespace lash::sweep;
 
@@ -64,4 +67,66 @@ TEST(Sweep, SummaryCountsAndMedian) {
   ASSERT_EQ(s.per_waveform.size(), 1u);
   EXPECT_EQ(s.per_waveform[0].waveform, "sine");
   EXPECT_EQ(s.unphysical_reported, 0u);
+}
+
+// Verdict checks 7 and 8 in the sweep (docs/sweep.md): with ci_tolerance F in [estimator], a side
+// identified without it stays identified exactly when its 95 % intervals (batch means over the
+// run's own record, recomputed here from the run's trace) hold no impossible value and those of
+// K, tau and c each satisfy (hi - lo) / |hi + lo| <= F, computed here by hand; else `uncertain`.
+// F is the median of the runs' widest ratios, so both outcomes occur.
+TEST(Sweep, CiToleranceJudgesEachSideByItsIntervals) {
+  Campaign c = load_campaign(std::string(LASH_SOURCE_DIR) + "/config/campaigns/e3_motor_cart_lash.toml");
+  c.runs.resize(12);  // the whole 30 s: sine 2 V at 2,4,6,8 rad/s x 3 repeats
+  struct Seen {
+    lash::sweep::RunResult plain;
+    lash::PerSide<lash::SideIntervals> ci;
+    lash::PerSide<double> widest{0.0, 0.0};
+  };
+  std::vector<Seen> runs;
+  std::vector<double> ratios;
+  for (const auto& spec : c.runs) {
+    std::vector<double> v, y;
+    Seen s;
+    s.plain = run_one(c, spec, [&](const TraceRow& r) {
+      v.push_back(r.v);
+      y.push_back(r.y);
+    });
+    lash::PerSide<lash::SideParams> p;
+    for (const lash::Side sd : {lash::Side::right, lash::Side::left}) {
+      const auto& q = s.plain.side[sd];
+      p[sd] = {q.a1, q.b1, q.c, lash::sweep::kNaN, q.identified, lash::Reason::none};
+    }
+    s.ci = lash::batch_means_intervals(c.estimator, v, y, p);
+    for (const lash::Side sd : {lash::Side::right, lash::Side::left}) {
+      if (!s.plain.side[sd].identified) continue;
+      const auto& i = s.ci[sd];
+      for (const lash::Interval* x : {&i.K, &i.tau_s, &i.c})
+        s.widest[sd] = std::max(s.widest[sd], x->valid() ? (x->hi - x->lo) / std::fabs(x->hi + x->lo) : INFINITY);
+      if (std::isfinite(s.widest[sd])) ratios.push_back(s.widest[sd]);
+    }
+    runs.push_back(s);
+  }
+  ASSERT_GE(ratios.size(), 12u);
+  std::sort(ratios.begin(), ratios.end());
+  const double F = ratios[ratios.size() / 2];
+  c.estimator.ci_tolerance = F;
+  std::size_t kept = 0, judged = 0;
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    const auto got = run_one(c, c.runs[k]);
+    EXPECT_EQ(got.nrmse, runs[k].plain.nrmse) << k;  // the run itself is unchanged
+    for (const lash::Side sd : {lash::Side::right, lash::Side::left}) {
+      const auto& i = runs[k].ci[sd];
+      const bool possible = i.K.valid() && i.K.lo > 0.0 && i.tau_s.lo > 0.0 && i.a1.hi < 0.0 &&
+                            (sd == lash::Side::right ? i.c.lo >= 0.0 : i.c.hi <= 0.0);
+      const bool want = runs[k].plain.side[sd].identified && possible && runs[k].widest[sd] <= F;
+      EXPECT_EQ(got.side[sd].identified, want) << k << " side " << static_cast<int>(sd);
+      if (runs[k].plain.side[sd].identified && !want) {
+        EXPECT_EQ(got.side[sd].rejected, "uncertain") << k;
+      }
+      judged += runs[k].plain.side[sd].identified ? 1 : 0;
+      kept += got.side[sd].identified ? 1 : 0;
+    }
+  }
+  EXPECT_GT(kept, 0u);
+  EXPECT_LT(kept, judged);
 }
