@@ -254,7 +254,7 @@ DataTraits analyse_record(const RecordColumns& rec, double dt_s, YEdits ed) {
   constexpr std::size_t kChunk = 1024, kLead = 40;
   std::vector<double> vb(kChunk), yb(kLead + kChunk), d2(kChunk), rate(kChunk), acc(kChunk);
   std::size_t n_steps = 0;
-  double min_step = std::numeric_limits<double>::infinity();
+  double min_step = std::numeric_limits<double>::infinity(), step_scale = 0.0;
   const double rate_div = 40.0 * dt_s, acc_div = dt_s * dt_s;
   // the pass over the selections `active` (a bit per selection); returns the count of finite pairs
   const auto pass = [&](unsigned active, bool first) {
@@ -292,14 +292,15 @@ DataTraits analyse_record(const RecordColumns& rec, double dt_s, YEdits ed) {
         for (std::size_t j = j40; j < m; ++j) rate[j - j40] = std::fabs(yc[j] - yc[j - 40]) / rate_div;
         if (first) {  // in locals: kept in registers (the selections' add is in another file)
           std::size_t ns = n_steps;
-          double ms = min_step;
+          double ms = min_step, sc = step_scale;
           for (std::size_t j = j1; j < m; ++j) {
-            const double st = std::fabs(yc[j] - yc[j - 1]);
+            const double st = quantum_step(yc[j - 1], yc[j], sc);
             ns += st > 0.0 ? 1 : 0;
             ms = st > 0.0 ? std::min(ms, st) : ms;
           }
           n_steps = ns;
           min_step = ms;
+          step_scale = sc;
         }
         const std::array<std::pair<const double*, std::size_t>, 5> seq{
             {{vb.data(), m}, {yc, m}, {d2.data(), m - j2}, {rate.data(), m - j40}, {acc.data(), n_acc}}};
@@ -344,7 +345,7 @@ DataTraits analyse_record(const RecordColumns& rec, double dt_s, YEdits ed) {
     const double q = min_step;
     const std::size_t off_allowed = n_steps - n_steps * 99 / 100;
     std::size_t off = 0, seen = 0;
-    double y_prev = 0.0;
+    double y_prev = 0.0, scale = 0.0;
     const std::size_t n_all = n;
     std::size_t e = 0, next_edit = ed.rows.empty() ? kNoEdit : ed.rows[0];
     for_chunks(rec.store, rec.vy, 0, n_all, [&](std::size_t base, const auto& cols) {
@@ -358,7 +359,7 @@ DataTraits analyse_record(const RecordColumns& rec, double dt_s, YEdits ed) {
         }
         if (!(std::isfinite(v[j]) && std::isfinite(yi))) continue;
         if (seen++ >= 1) {
-          const double s = std::fabs(yi - y_prev);
+          const double s = quantum_step(y_prev, yi, scale);
           if (s > 0.0) off += std::fabs(s / q - std::round(s / q)) < 1e-3 ? 0u : 1u;
         }
         y_prev = yi;

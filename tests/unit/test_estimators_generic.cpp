@@ -332,6 +332,26 @@ TYPED_TEST(EstimatorInvariants, RestartKeepsEstimatesAndClearsTheSignalHistory) 
       << "updates resume after the warm-up";
 }
 
+// Verdict check 2 reads the regressors of the updates; those of the record's first samples still
+// hold a moving average's zero initial state. A constant input through MA4 (v and y filtered, as
+// lash chooses for a quantised output) ramps 0, 1, 2, 3, 4 V over them: without skipping them as
+// evidence the side looked excited (reason unphysical instead of not_excited). Hand-made record:
+// v = 4 V throughout, y an encoder velocity alternating between two counts per sample.
+TEST(Verdict, ConstantInputThroughAMovingAverageIsNotExcited) {
+  EstimatorConfig c(ModelKind::output_deadzone, 0.001);
+  c.noise.filter_length = 4;
+  c.noise.filter_input = true;
+  OutputDeadzoneEstimator con(c), var(c);
+  for (int k = 0; k < 5000; ++k) {
+    const double y = (k % 3 == 0 ? 126.0 : 127.0) * 3e-3;  // [m/s]: counts of 3 µm per 1 ms
+    con.step(4.0, y);
+    var.step(k % 1000 < 500 ? 4.0 : 4.5, y);  // the same output, an input that does vary
+  }
+  EXPECT_GT(con.updates(Side::right), 4000u);
+  EXPECT_EQ(con.params(Side::right).reason, Reason::not_excited);
+  EXPECT_NE(var.params(Side::right).reason, Reason::not_excited);  // the check still sees a varying v
+}
+
 // verdict_rules: the order of the checks and the condition test, with hand-made cases.
 TEST(Verdict, ChecksInOrder) {
   verdict_rules::Evidence e;

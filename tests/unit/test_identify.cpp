@@ -758,8 +758,12 @@ DataTraits analyse_reference(const std::vector<double>& v, const std::vector<dou
     if (d1 * d0 > 0.0) acc.push_back(std::fabs(d1 - d0) / (dt * dt));
   }
   d.yddot_p90 = quantile(acc, 0.9);
-  for (std::size_t k = 1; k < yf.size(); ++k)
-    if (const double s = std::fabs(yf[k] - yf[k - 1]); s > 0.0) steps.push_back(s);
+  // a step below 1e-9 of the largest |y| so far is rounding (auto.hpp quantum_step), written out here
+  double scale = std::fabs(yf[0]);
+  for (std::size_t k = 1; k < yf.size(); ++k) {
+    scale = std::max(scale, std::fabs(yf[k]));
+    if (const double s = std::fabs(yf[k] - yf[k - 1]); s > 1e-9 * scale) steps.push_back(s);
+  }
   if (steps.size() > 10) {
     const double q = *std::min_element(steps.begin(), steps.end());
     std::size_t on = 0;
@@ -799,6 +803,23 @@ TEST(AnalyseRecord, QuantilesEqualFullCopiesToTheBit) {
   for (auto& x : vr) x = rng.gaussian() * 100.0;
   expect_same_traits(analyse_record(vr, y, 0.002), analyse_reference(vr, y, 0.002), "white input");
   EXPECT_GT(analyse_record(v, yq, 0.001).quantum, 0.0);  // the encoder step is found
+  // An encoder velocity as a rig computes it, (counts(k) − counts(k−1))·q/T: the same count
+  // difference gives values a few ulps apart (here: the position's rounding), steps of ~1e-17
+  // that are not motion. The quantum is still the encoder's velocity step q/T.
+  const double q = 1e-5, T = 0.001;
+  std::vector<double> yv(n);
+  double prev = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double pos = std::round(50.0 * std::sin(static_cast<double>(k) / 700.0) / q) * q + 1.0;  // [m]
+    yv[k] = (pos - prev) / T;
+    prev = pos;
+  }
+  std::size_t tiny = 0;
+  for (std::size_t k = 1; k < n; ++k) tiny += yv[k] != yv[k - 1] && std::fabs(yv[k] - yv[k - 1]) < 1e-9 ? 1u : 0u;
+  ASSERT_GT(tiny, n / 100);  // more than 1 % of the steps: the grid rule would fail on them
+  const DataTraits tv = analyse_record(v, yv, T);
+  expect_same_traits(tv, analyse_reference(v, yv, T), "encoder velocity");
+  EXPECT_NEAR(tv.quantum, q / T, 1e-9 * q / T);
 }
 
 // Past OrderStatistic's cap (2^18 kept values a quantile): at 5·10⁶ rows the median of |Δ²y| keeps

@@ -8,6 +8,7 @@
 #include <set>
 #include <string>
 
+#include "lash/identify/auto.hpp"
 #include "lash/identify/config_fields.hpp"
 #include "lash/identify/config_file.hpp"
 #include "lash/identify/config_sources.hpp"
@@ -61,6 +62,29 @@ TEST(IdentifyConfig, PerModelLashDefaults) {
   EXPECT_EQ(carts.stage2_start_s, 5.0);
   EXPECT_EQ(carts.accel_limit, 1.0);
   for (ModelKind m : kModels) EXPECT_EQ(all_values(EstimatorConfig(m)), all_values(preset_config(m, Preset::lash)));
+}
+
+// The output-deadzone rule of docs/identification.md "Defaults chosen from the data": λ from the
+// sample time (a 2 s memory), and a quantised output (an encoder velocity) through a 4-point
+// moving average on y and v; an output that is not quantised keeps the unfiltered default.
+TEST(IdentifyConfig, OutputDeadzoneTunedToQuantisedOutput) {
+  DataTraits d;
+  d.dt_s = 0.001;
+  d.samples = 30000;
+  EstimatorConfig plain(ModelKind::output_deadzone, 0.001);
+  tune_to_data(plain, d);
+  EXPECT_DOUBLE_EQ(plain.rls.lambda, 1.0 - 0.001 / 2.0);
+  EXPECT_EQ(plain.noise.filter_length, 1u);
+  EXPECT_FALSE(plain.noise.filter_input);
+  d.quantum = 0.00196;  // the cart's encoder velocity step [m/s]
+  EstimatorConfig quantised(ModelKind::output_deadzone, 0.001);
+  tune_to_data(quantised, d);
+  EXPECT_DOUBLE_EQ(quantised.rls.lambda, 0.9995);
+  EXPECT_EQ(quantised.noise.filter_length, 4u);
+  EXPECT_TRUE(quantised.noise.filter_input);
+  d.dt_s = 0.5;  // a slow record: λ clamped at 0.99
+  tune_to_data(quantised, d);
+  EXPECT_EQ(quantised.rls.lambda, 0.99);
 }
 
 TEST(IdentifyConfig, ThesisSettingsByName) {

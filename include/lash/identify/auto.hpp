@@ -52,9 +52,19 @@ struct DataTraits {
   /// 90 % quantile of |ÿ| (second difference / T²) over samples where y moved in the same
   /// direction three samples in a row [y unit/s²] (coupled carts: the acceleration gate's scale).
   double yddot_p90 = 0.0;
-  /// Smallest step of y (encoder resolution) [y unit]; 0 when y is not visibly quantised.
+  /// Smallest step of y (encoder resolution) [y unit]; 0 when y is not visibly quantised: 99 % of
+  /// the steps (quantum_step) are integer multiples of the smallest one.
   double quantum = 0.0;
 };
+/// |b − a| as a step of y for DataTraits::quantum, over consecutive pairs (a, b) of a record:
+/// 0 when it is below 1e-9 of `scale`, the largest |y| so far (updated here): floating-point
+/// rounding, not a change. An encoder velocity, counts·q/T differenced, repeats its value up to a
+/// few ulps of the position (steps of 5e-17 to 3e-15 m/s on the cart hid its 1.96 mm/s quantum).
+inline double quantum_step(double a, double b, double& scale) noexcept {
+  scale = std::fmax(scale, std::fmax(std::fabs(a), std::fabs(b)));
+  const double s = std::fabs(b - a);
+  return s > 1e-9 * scale ? s : 0.0;
+}
 /// Not real-time safe. Non-finite samples are ignored. `y_edits`: samples of y read from
 /// elsewhere (the outlier gate's replacements, any_estimator.hpp YEdits).
 DataTraits analyse_record(std::span<const double> v, std::span<const double> y, double dt_s, YEdits y_edits = {});

@@ -13,7 +13,10 @@ class OutputDeadzoneModel : public detail::SideRegressions {
   static constexpr ModelTraits traits{
       .kind = ModelKind::output_deadzone, .name = "output-deadzone", .has_c = true, .free_run_first = true};
   static void defaults(EstimatorConfig& c);
+  /// λ from the sample time; a quantised output (DataTraits::quantum > 0) also gets a moving
+  /// average of kQuantisedOutputFilter samples on y and v.
   static void tune(EstimatorConfig& c, const DataTraits& d);
+  static constexpr std::size_t kQuantisedOutputFilter = 4;
   /// c = −e/(1 + a1) of side s's raw estimate (eq. 36); NaN when a1 ≈ −1.
   double edge(Side s) const noexcept {
     const auto& e = rls_[s].eta();
