@@ -17,7 +17,7 @@ std::uint64_t start_index(double s, double dt) noexcept {
 
 EstimatorCore::EstimatorCore(const EstimatorConfig& c) : cfg(c), pre(c.noise, c.dt_s), warmup(detail::warmup_samples(c, pre)) {
   fit.k0 = detail::start_index(c.fit_start_s, c.dt_s);
-  start = static_cast<std::uint32_t>(pre.memory_samples() + 1);  // the regressors use v(k−1), y(k−1)
+  start = pre.memory_samples() + 1;  // the regressors use v(k−1), y(k−1)
 }
 
 }  // namespace lash

@@ -125,10 +125,10 @@ struct EstimatorCore {
   EstimatorConfig cfg;
   Preprocessor pre;
   std::uint32_t warmup = 0, warm = 0;  // warm-up length; samples of it still to go
-  /// Samples at the record's start (after construction) whose regressors still hold the filters'
-  /// zero initial state: they update, but are not evidence of excitation (a moving average's
-  /// start-up ramp would make a constant input take several values).
-  std::uint32_t start = 0;
+  /// The record's first samples (fit.k counts them since construction) whose regressors still
+  /// hold the filters' zero initial state: they update, but are not evidence of excitation (a
+  /// moving average's start-up ramp would make a constant input take several values).
+  std::uint64_t start = 0;
   detail::History hist;                // y(k−1), y(k−2), … after the preprocessing (the IV instrument)
   PerSide<detail::ValueRange> vrange{}, yrange{};  // v(k−1), y(k−1) over each side's updates
   detail::FitWindow fit;
@@ -150,7 +150,7 @@ struct EstimatorCore {
   }
   /// The regressors of an update of side s enter its value ranges (verdict check 2).
   void seen(Side s, double v, double y) noexcept {
-    if (start > 0) return;
+    if (fit.k < start) return;  // fit.k: this sample's index (fit.add comes after the update)
     vrange[s].add(v);
     yrange[s].add(y);
   }
@@ -295,7 +295,6 @@ double SwitchingEstimator<Model>::step(double v, double y) noexcept {
   c_.v1 = s.v;
   c_.vraw1 = v;
   c_.fit.add(y, c_.ysim);
-  if (c_.start > 0) --c_.start;
   return c_.yhat;
 }
 
