@@ -68,6 +68,7 @@ void CommonSettings::validate() const {
 void RegressionFilterSettings::validate() const {
   require(filter_length >= 1 && filter_length <= 100000, "filter-length", "must be in 1..100000");
   require(input_delay <= 100000, "input-delay", "must be <= 100000 samples");
+  require(dead_time <= 100000, "dead-time", "must be <= 100000 samples");
 }
 
 void DerivativeSwitchingSettings::validate() const {

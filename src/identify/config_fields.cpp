@@ -106,6 +106,8 @@ const ConfigField kFields[] = {
    [](C& c) -> Ref { return &c.noise.filter_input; }},
   {"noise", "input_delay", "input-delay", "Delay of v [samples] to keep it aligned with a filtered y", kFilter,
    [](C& c) -> Ref { return &c.noise.input_delay; }, 0, 100000},
+  {"noise", "dead_time", "dead-time", "Plant dead time [samples]: y(k) responds to v(k-1-n); the free run too",
+   kFilter, [](C& c) -> Ref { return &c.noise.dead_time; }, 0, 100000},
   // CommonSettings::noise (DerivativeSwitchingSettings)
   {"noise", "derivative_prefilter_length", "derivative-prefilter-length",
    "Moving average on y before differencing [samples] (0 = --filter-length)", kDeriv,

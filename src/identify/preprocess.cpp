@@ -7,7 +7,8 @@
 namespace lash {
 
 Preprocessor::Preprocessor(const NoiseSettings& s, double dt_s)
-    : identity_(s.filter_length == 1 && !s.filter_input && s.input_delay == 0 && s.derivative_filter_length == 1 &&
+    : identity_(s.filter_length == 1 && !s.filter_input && s.input_delay == 0 && s.dead_time == 0 &&
+                s.derivative_filter_length == 1 &&
                 s.align_delay == 0 && (s.derivative_prefilter_length == 0 || s.derivative_prefilter_length == 1)),
       filter_y_(s.filter_length > 1),
       filter_v_(s.filter_input && s.filter_length > 1),
@@ -19,15 +20,17 @@ Preprocessor::Preprocessor(const NoiseSettings& s, double dt_s)
       ma_y_(s.filter_length),
       ma_p_(s.derivative_prefilter_length == 0 ? 1 : s.derivative_prefilter_length),
       ma_vy_(s.filter_input && s.filter_length > 1 ? s.filter_length : 1),
-      lag_v_(s.input_delay + s.align_delay),
+      lag_v_(s.input_delay + s.align_delay + s.dead_time),
       lag_y_(s.align_delay),
-      lag_d_(s.derivative_filter_length) {
+      lag_d_(s.derivative_filter_length),
+      dead_(s.dead_time) {
   if (!(std::isfinite(dt_s) && dt_s > 0.0)) throw std::invalid_argument("dt must be > 0");
   const std::size_t need = std::max({lag_v_, lag_y_, lag_d_}) + 1;
   while (cap_ < need) cap_ *= 2;
   mask_ = cap_ - 1;
   x_ring_ = separate_pre_ ? 2 * cap_ : cap_;
-  hist_.assign(3 * cap_, 0.0);
+  raw_ring_ = 3 * cap_;
+  hist_.assign((dead_ != 0 ? 4 : 3) * cap_, 0.0);
 }
 
 void Preprocessor::reset() noexcept {
@@ -42,7 +45,8 @@ void Preprocessor::reset() noexcept {
 std::size_t Preprocessor::memory_samples() const noexcept {
   if (identity_) return 1;  // ẏ = (y − y_prev)/T
   const std::size_t m = filter_y_ ? s_.filter_length : 1;
-  const std::size_t regression = std::max(m, filter_v_ ? s_.filter_length : 1) + s_.input_delay + s_.align_delay;
+  const std::size_t regression = std::max(m, filter_v_ ? s_.filter_length : 1) + s_.input_delay + s_.align_delay +
+                                  s_.dead_time;
   const std::size_t pre = separate_pre_ ? (filter_p_ ? s_.derivative_prefilter_length : 1) : m;
   const std::size_t derivative = pre + 1 + (s_.derivative_filter_length > 1 ? s_.derivative_filter_length : 1);
   return std::max(regression, derivative);

@@ -69,6 +69,10 @@ struct RegressionFilterSettings {
   bool filter_input = false;
   /// Pure delay of v [samples] that keeps v aligned with a filtered y when v itself is not filtered.
   std::size_t input_delay = 0;
+  /// The plant's dead time [samples]: y(k) responds to v(k−1−n), e.g. an actuator's fast lag
+  /// (a valve solenoid's) taken as a pure delay. Unlike `input_delay`, the free run (verdict
+  /// check 6, y_sim) is driven by the delayed v too: it is part of the model. 0 = none.
+  std::size_t dead_time = 0;
   static constexpr ModelSet models = kAllModels;
   void validate() const;
 };

@@ -13,7 +13,7 @@
 ///   static constexpr ModelTraits traits;
 ///   explicit Model(const EstimatorConfig&);
 ///   double update(EstimatorCore&, const Conditioned&, bool warming) noexcept;  // ŷ(k)
-///   void free_run(EstimatorCore&) noexcept;      // y_sim(k) into core.ysim (reads core.vraw1 = v(k−1))
+///   void free_run(EstimatorCore&) noexcept;      // y_sim(k) into core.ysim (reads core.vraw1 = v(k−1−dead_time))
 ///   verdict_rules::Evidence evidence(const EstimatorCore&, Side) const noexcept;
 ///   bool conditioned(const EstimatorCore&, Side) const noexcept;
 ///   std::uint64_t side_updates(Side) const noexcept, rls_skipped() const noexcept;
@@ -133,7 +133,7 @@ struct EstimatorCore {
   PerSide<detail::ValueRange> vrange{}, yrange{};  // v(k−1), y(k−1) over each side's updates
   detail::FitWindow fit;
   double y1 = 0.0, v1 = 0.0;  // the previous conditioned sample
-  double vraw1 = 0.0;         // the previous raw v (the free run's input)
+  double vraw1 = 0.0;         // the previous raw v, delayed by the dead time (the free run's input)
   double yhat = 0.0, ysim = 0.0;
   std::uint64_t skipped = 0;
 
@@ -293,7 +293,7 @@ double SwitchingEstimator<Model>::step(double v, double y) noexcept {
   c_.hist.push(s.y);
   c_.y1 = s.y;
   c_.v1 = s.v;
-  c_.vraw1 = v;
+  c_.vraw1 = s.vplant;
   c_.fit.add(y, c_.ysim);
   return c_.yhat;
 }

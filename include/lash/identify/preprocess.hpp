@@ -4,7 +4,8 @@
 ///   y_f = MA_M(y),  v_f = MA_M(v) (filter_input) or Delay_n(v),
 ///   ẏ  = MA_M2(BackwardDifference(MA_Mp(y)))       (eq. 26; var(ẏ) = 2 var(y)/T², eq. 33)
 ///        with Mp = derivative_prefilter_length (0: the regression filter M)
-///   regression signals = Delay_align(v_f), Delay_align(y_f) so they line up with ẏ.
+///   regression signals = Delay_align(v_f), Delay_align(y_f) so they line up with ẏ;
+///   a plant dead time n delays the regression's v by n more and gives the free run v(k − n).
 /// Storage is allocated at construction; step() is noexcept, O(1), allocation-free.
 #include <cstddef>
 #include <cstdint>
@@ -20,6 +21,7 @@ struct Conditioned {
   double v;     ///< input for the regression [v unit]
   double y;     ///< output for the regression [y unit]
   double ydot;  ///< derivative used for switching [y unit/s]
+  double vplant;  ///< the raw v delayed by the plant's dead time (the free run's input) [v unit]
 };
 
 class Preprocessor {
@@ -31,7 +33,7 @@ class Preprocessor {
     if (identity_) [[unlikely]] {
       const double d = (y - y_prev_) * inv_dt_;
       y_prev_ = y;
-      return {v, y, d};
+      return {v, y, d, v};
     }
     double yf = y, vf = v;
     if (filter_v_) ma_vy_.step(v, y, vf, yf);  // filter_v_ implies filter_y_ (the same length M)
@@ -42,10 +44,15 @@ class Preprocessor {
     h[k] = vf;
     h[cap_ + k] = yf;
     if (separate_pre_) h[2 * cap_ + k] = x;  // otherwise x = y_f, read from y_f's ring
+    double vp = v;
+    if (dead_ != 0) {  // the raw v's own ring: the free run reads v(k − dead_time)
+      h[raw_ring_ + k] = v;
+      vp = h[raw_ring_ + ((k - dead_) & mask_)];
+    }
     // MA_M2 of the backward difference telescopes: (1/M2)·Σ_{j<M2} (x(k−j) − x(k−j−1))/T
     // = (x(k) − x(k−M2))/(M2·T), with x = 0 before the first sample as in every filter.
     const double d = (x - h[x_ring_ + ((k - lag_d_) & mask_)]) * inv_ddt_;
-    return {h[(k - lag_v_) & mask_], h[cap_ + ((k - lag_y_) & mask_)], d};
+    return {h[(k - lag_v_) & mask_], h[cap_ + ((k - lag_y_) & mask_)], d, vp};
   }
 
   void reset() noexcept;
@@ -66,8 +73,8 @@ class Preprocessor {
   MovingAveragePair ma_vy_;  // v and y together when both are filtered
   // One history ring per signal (v_f, y_f, derivative input), cap_ (a power of two) slots each:
   // the input and alignment delays and the derivative read from it.
-  std::size_t cap_ = 1, mask_ = 0, x_ring_ = 0;
-  std::size_t lag_v_ = 0, lag_y_ = 0, lag_d_ = 1;
+  std::size_t cap_ = 1, mask_ = 0, x_ring_ = 0, raw_ring_ = 0;
+  std::size_t lag_v_ = 0, lag_y_ = 0, lag_d_ = 1, dead_ = 0;
   std::uint64_t k_ = 0;
   std::vector<double> hist_;
 };
