@@ -2,7 +2,7 @@
 """The figure of docs/rigs.md "What the first-order model cannot see": runs the lash campaigns E3
 and E4 with `lash sweep` and plots, per identified side,
  - E3 (motor cart): the error of c [%] against the input frequency, one marker per waveform;
- - E4 (pilot valve): the identified τ [s] against the run's largest |pressure| [kPa], with the
+ - E4 (pilot valve, its solenoid lag taken as a dead time of 2 samples): the identified τ [s] against the run's largest |pressure| [kPa], with the
    rig's τ(p) = τ0/(1 + |p|/p_half), τ(p) plus the solenoid's lag, and τ0 (the sweep's "true" τ).
 Usage: scripts/rigs_identifiability.py LASH OUT.png   (LASH: build/bin/lash)"""
 import csv, math, os, subprocess, sys, tempfile
@@ -64,7 +64,7 @@ a4.plot(p, [tau0 / (1 + x / p_half) + tau_sol for x in p], "k:", label="τ(p) + 
 a4.axhline(tau0, color="k", ls="--", lw=1, label="τ0 = 0.075 s (the sweep's true τ)")
 a4.set_xlabel("largest |pilot pressure| of the run [kPa]")
 a4.set_ylabel("identified τ [s]")
-a4.set_title("E4 pilot valve: one τ for a pressure-dependent lag")
+a4.set_title("E4 pilot valve, dead time 2 samples: τ against pressure")
 a4.set_ylim(0.0, 0.15)
 a4.legend(loc="upper right", fontsize=8)
 a4.grid(alpha=0.3)

@@ -64,7 +64,8 @@ Summary summarize(const Campaign& c, const std::vector<RunResult>& results) {
         const SideResult& x = r.side[sd];
         const auto& t = r.truth.side[sd];
         double e = 0.0;  // the largest error; NaN (e.g. no τ from a1 <= 0) wins
-        for (const double x_e : {relative_error(x.gain, t.gain), relative_error(x.tau_s, t.tau_s), relative_error(x.c, t.c),
+        for (const double x_e : {relative_error(x.gain, t.gain), compares_tau(c.rig.kind) ? relative_error(x.tau_s, t.tau_s) : 0.0,
+                                 relative_error(x.c, t.c),
                                  r.d_identified ? relative_error(r.d, r.truth.d) : 0.0})
           e = (std::isnan(x_e) || x_e > e) ? x_e : e;
         if (std::isnan(e)) e = std::numeric_limits<double>::infinity();
@@ -123,8 +124,9 @@ std::string summary_text(const Campaign& c, const Summary& s, const std::vector<
                      s.unphysical_reported);
   out += fmt::format("parameters within {} of the rig's true effective values: {}/{} runs with identified sides\n",
                      pct(s.param_tolerance), s.params_within, s.params_checked);
-  out += fmt::format("identified sides within {} of the true K, tau, c{}: {}/{} = {}; above 20 %: {}\n",
-                     pct(s.param_tolerance), c.rig.kind == rigs::RigKind::coupled_carts ? ", d" : "", s.sides_within,
+  out += fmt::format("identified sides within {} of the true K, {}c{}: {}/{} = {}; above 20 %: {}\n",
+                     pct(s.param_tolerance), compares_tau(c.rig.kind) ? "tau, " : "",
+                     c.rig.kind == rigs::RigKind::coupled_carts ? ", d" : "", s.sides_within,
                      s.sides_identified,
                      pct(s.sides_identified ? static_cast<double>(s.sides_within) / static_cast<double>(s.sides_identified) : 0.0),
                      s.sides_above_20);

@@ -240,7 +240,7 @@ RunResult run_one(const Campaign& c, const RunSpec& r, const TraceFn& trace) {
       out = run_deadzone_model(c, ec, r, rig, sig, n, score, trace);
       out.truth = rig.effective();
       judge_precision<rigs::MotorCart>(c, ec, r, same, out);
-      score_params(out, true);
+      score_params(out, compares_tau(c.rig.kind));
       break;
     }
     case rigs::RigKind::pilot_valve: {
@@ -248,7 +248,7 @@ RunResult run_one(const Campaign& c, const RunSpec& r, const TraceFn& trace) {
       out = run_deadzone_model(c, ec, r, rig, sig, n, score, trace);
       out.truth = c.rig.pilot_valve.effective(c.dt_s, 0.0);
       judge_precision<rigs::PilotValveRig>(c, ec, r, same, out);
-      score_params(out, false);
+      score_params(out, compares_tau(c.rig.kind));
       break;
     }
     case rigs::RigKind::coupled_carts: {
@@ -273,7 +273,7 @@ RunResult run_one(const Campaign& c, const RunSpec& r, const TraceFn& trace) {
       out.d_identified = est.deadband_reason() == Reason::none;
       out.truth = rig.effective();
       judge_precision<rigs::CoupledCarts>(c, ec, r, pos_vel, out);
-      score_params(out, true);
+      score_params(out, compares_tau(c.rig.kind));
       break;
     }
   }

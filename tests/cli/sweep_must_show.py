@@ -55,14 +55,19 @@ def check_common(name, summary, rows, expected_runs):
                 bad = [k for k in ("a1", "b1", "c", "K") if not math.isfinite(f(r[f"{k}_{sd}"]))]
                 if bad:
                     fail.append(f"{name} run {r['run']}: identified side {sd} with non-finite {bad}")
-    # identified sides within 5 % of the true K, tau, c (and d where identified), recomputed here
+    # identified sides within 5 % of the true K, tau, c (and d where identified), recomputed here;
+    # the valve's tau is not a rig constant (it falls with pressure: docs/rigs.md), so its sides
+    # are scored on K and c
+    with_tau = summary["rig"] != "pilot_valve"
     within = above = ident = 0
     for r in rows:
         for sd in ("r", "l"):
             if r["identified_" + sd] != "1":
                 continue
             ident += 1
-            pairs = [(f"K_{sd}", f"true_K_{sd}"), (f"tau_{sd}_s", f"true_tau_{sd}_s"), (f"c_{sd}", f"true_c_{sd}")]
+            pairs = [(f"K_{sd}", f"true_K_{sd}"), (f"c_{sd}", f"true_c_{sd}")]
+            if with_tau:
+                pairs.append((f"tau_{sd}_s", f"true_tau_{sd}_s"))
             if r["identified_d"] == "1":
                 pairs.append(("d", "true_d"))
             errs = [abs(f(r[a]) - f(r[b])) / abs(f(r[b])) for a, b in pairs]
@@ -72,7 +77,7 @@ def check_common(name, summary, rows, expected_runs):
     if (within, above) != (summary["sides_within_tolerance"], summary["sides_above_20pct"]):
         fail.append(f"{name}: summary sides within 5 % / above 20 % {summary['sides_within_tolerance']}/"
                     f"{summary['sides_above_20pct']} != CSV {within}/{above}")
-    print(f"{name}: identified sides within 5 % of the true K, tau, c: {within}/{ident}"
+    print(f"{name}: identified sides within 5 % of the true K, {'tau, ' if with_tau else ''}c: {within}/{ident}"
           f" = {100 * within / max(ident, 1):.1f} %, above 20 %: {above} (issue 24 goal >= 95 % and 0: not asserted)")
     per = {w: f"{v['good']}/{v['runs']}" for w, v in summary["per_waveform"].items()}
     pc = lambda x: "nan" if x is None else f"{100 * x:.2f}"
@@ -100,8 +105,15 @@ if not (s["sides_within_tolerance"] >= 0.65 * ident and s["sides_above_20pct"] <
 s, rows, _ = sweep("e4_pilot_valve")
 check_common("E4 thesis settings", s, rows, 164)
 s, rows, _ = sweep("e4_pilot_valve_lash")
-if check_common("E4 lash settings", s, rows, 164)[0] < 0.91:
+share, ident = check_common("E4 lash settings", s, rows, 164)
+if share < 0.91:
     fail.append("E4 (lash settings): share of good runs below the thesis's 91 %")
+# A regression floor, not issue 24's goal: with the solenoid's lag as a dead time of 2 samples,
+# 150 of 219 identified sides have K and c within 5 % and none is above 20 % (without it: 89 of
+# 198 and 30 above 20 %, all at 5 and 10 rad/s). The counts were checked against the CSV above.
+if not (s["sides_within_tolerance"] >= 0.65 * ident and s["sides_above_20pct"] == 0):
+    fail.append(f"E4 (lash settings): {s['sides_within_tolerance']}/{ident} identified sides within 5 %, "
+                f"{s['sides_above_20pct']} above 20 % (floor: 65 % and none)")
 
 
 def check_e5(name, summary, rows, all_amplitudes):
