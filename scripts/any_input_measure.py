@@ -1,10 +1,12 @@
 #!/usr/bin/env python3
 """Issue 30 item 1: lash estimate --model deadzone-deadband with its defaults on the inputs users
-have: random-phase multisines and random-level steps, through random DZ -> G -> DB plants (edges,
+have: random-phase multisines, random-level steps and closed-loop operating data (the valve
+scenario's controller law on the plant, tracking a random-level reference), through random
+DZ -> G -> DB plants (edges,
 widths and dynamics not from the thesis) with E2-level measurement noise (sigma = 1.4 % of the
 output's amplitude, as E2's variance 200 on E1's +-1000). Prints each run's worst errors and
 returns them; tests/cli/estimate_any_input.py asserts on them.
-usage: any_input_measure.py LASH [N | A-B (seeds)] [kind ...]"""
+usage: any_input_measure.py LASH [N | A-B (seeds)] [kind ...]   (kinds: multisine steps closed-loop)"""
 import json, os, subprocess, sys, tempfile
 
 import numpy as np
@@ -45,12 +47,72 @@ def signal(kind, rng, n, amp):
     return v
 
 
-def run_one(lash, kind, seed, d, duration=150.0, amp=500.0):
-    rng = np.random.default_rng(1000 * seed + (1 if kind == "multisine" else 2))
+class PlantSim:
+    """The plant of plant_toml(p) written out by hand, one sample at a time (lash's Plant: y(k) from
+    v up to k-1; the deadband's side by the sign of v(k-1)); checked against `lash simulate`."""
+
+    def __init__(self, p):
+        self.p, self.w, self.u1, self.v1, self.y = p, 0.0, 0.0, 0.0, 0.0
+
+    def output(self):  # y(k), before v(k) is known
+        p = self.p
+        self.w = -p["a1"] * self.w + p["b1"] * self.u1
+        d = p["dr"] if self.v1 >= 0 else p["dl"]
+        if self.w < self.y - d:
+            self.y = self.w + d
+        elif self.w > self.y + d:
+            self.y = self.w - d
+        return self.y
+
+    def drive(self, v):  # v(k)
+        p = self.p
+        self.u1 = v - p["cr"] if v > p["cr"] else (v - p["cl"] if v < p["cl"] else 0.0)
+        self.v1 = v
+
+
+def closed_loop(p, rng, n, sigma, noise_seed):
+    """The valve scenario's law (config/scenarios/closed_loop/valve_no_drift.toml) scaled to the
+    plant's gain K: u = kp (r - y) + ki int(r - y) + r/K (integration held while the command is
+    clamped), i = DI(u) with a deadzone inverse at 90 % of the true edges (a rough calibration),
+    clamped to +-2000. The reference: random levels in +-400 K held 0.5-2 s. Returns (v, y) with
+    the measured y (noise sigma, fed back)."""
+    k_gain = p["b1"] / (1 + p["a1"])
+    kp, ki = 0.5 * 2.15 / k_gain, 10.0 * 2.15 / k_gain
+    noise = np.random.default_rng(noise_seed).normal(0.0, sigma, n) if sigma > 0 else np.zeros(n)
+    r = np.empty(n)
+    k = 0
+    while k < n:
+        h = int(rng.uniform(0.5, 2.0) / DT)
+        r[k:k + h] = rng.uniform(-400, 400) * k_gain
+        k += h
+    sim, integ = PlantSim(p), 0.0
+    v, y = np.empty(n), np.empty(n)
+    for k in range(n):
+        y[k] = sim.output() + noise[k]
+        e = r[k] - y[k]
+        u = kp * e + integ + r[k] / k_gain
+        i = u + 0.9 * p["cr"] if u > 0 else (u + 0.9 * p["cl"] if u < 0 else 0.0)
+        if abs(i) < 2000:
+            integ += ki * DT * e
+        v[k] = min(2000.0, max(-2000.0, i))
+        sim.drive(v[k])
+    return v, y
+
+
+def run_one(lash, kind, seed, d, duration=150.0, amp=500.0, noise=True):
+    rng = np.random.default_rng(1000 * seed + {"multisine": 1, "steps": 2, "closed-loop": 3}[kind])
     p = plant(rng)
     n = int(round(duration / DT))
-    v = signal(kind, rng, n, amp)
     inp, pl, rec = (os.path.join(d, f"{kind}{seed}_{x}") for x in ("in.csv", "plant.toml", "rec.csv"))
+    if kind == "closed-loop":
+        state = rng.bit_generator.state
+        y0 = closed_loop(p, rng, n, 0.0, seed)[1]
+        rng.bit_generator.state = state  # the same reference with noise
+        sigma = 0.014 * np.abs(y0).max() if noise else 0.0
+        v, y = closed_loop(p, rng, n, sigma, seed)
+        np.savetxt(rec, np.c_[np.arange(n) * DT, v, y], delimiter=",", header="t,v,y", comments="", fmt="%.17g")
+        return estimate_run(lash, kind, seed, rec, p, sigma)
+    v = signal(kind, rng, n, amp)
     np.savetxt(inp, np.c_[np.arange(n) * DT, v], delimiter=",", header="t,v", comments="", fmt="%.17g")
     open(pl, "w").write(plant_toml(p))
     # noise: 1.4 % of the noise-free output's amplitude
@@ -61,6 +123,10 @@ def run_one(lash, kind, seed, d, duration=150.0, amp=500.0):
     sim = subprocess.run([lash, "simulate", pl, "--input-file", inp, "--noise-variance", repr(sigma ** 2),
                           "--seed", str(seed), "-o", rec], capture_output=True, text=True)
     assert sim.returncode == 0, sim.stderr
+    return estimate_run(lash, kind, seed, rec, p, sigma)
+
+
+def estimate_run(lash, kind, seed, rec, p, sigma):
     extra = os.environ.get("ANY_INPUT_ARGS", "").split()  # settings to compare (exploration)
     e = subprocess.run([lash, "estimate", rec, "--model", "deadzone-deadband", "--json", *extra], capture_output=True,
                        text=True)
