@@ -64,8 +64,8 @@ Summary summarize(const Campaign& c, const std::vector<RunResult>& results) {
         const SideResult& x = r.side[sd];
         const auto& t = r.truth.side[sd];
         double e = 0.0;  // the largest error; NaN (e.g. no τ from a1 <= 0) wins
-        for (const double x_e : {relative_error(x.gain, t.gain), compares_tau(c.rig.kind) ? relative_error(x.tau_s, t.tau_s) : 0.0,
-                                 relative_error(x.c, t.c),
+        const double tau_e = compares_tau(c.rig.kind) ? relative_error(x.tau_s, t.tau_s) : 0.0;
+        for (const double x_e : {relative_error(x.gain, t.gain), tau_e, relative_error(x.c, t.c),
                                  r.d_identified ? relative_error(r.d, r.truth.d) : 0.0})
           e = (std::isnan(x_e) || x_e > e) ? x_e : e;
         if (std::isnan(e)) e = std::numeric_limits<double>::infinity();
