@@ -378,20 +378,29 @@ TEST(Estimators, LinearRecoversItsModel) {
   EXPECT_NEAR(e.simulated(), r.y.back(), 1e-6 * (1 + std::fabs(r.y.back())));
 }
 
-TEST(Estimators, InputDeadzoneRecoversItsModel) {
-  // DZ(−1.5, 0.8) → G_r = 0.3/(z − 0.8), G_l = 0.45/(z − 0.7); T = 0.001; triangle 5 at 3 rad/s
+/// Delay(n) → DZ(−1.5, 0.8) → G_r = 0.3/(z − 0.8), G_l = 0.45/(z − 0.7); T = 0.001; triangle 5 at
+/// 3 rad/s for 10 s; and the input-deadzone settings that identify it (guesses ±2).
+Record input_deadzone_record(std::size_t delay) {
   std::vector<Block> b;
+  if (delay > 0) b.emplace_back(Delay(delay));
   b.emplace_back(Deadzone({-1.5, 0.8}));
   b.emplace_back(FirstOrder({{-0.8, 0.3}, {-0.7, 0.45}}));
   SignalSpec in;
   in.kind = Waveform::triangle;
   in.amplitude = 5;
   in.frequency_rad_s = 3;
-  const Record r = run_plant(std::move(b), 0.001, in, 10);
+  return run_plant(std::move(b), 0.001, in, 10);
+}
+
+EstimatorConfig input_deadzone_config(std::size_t dead_time) {
   EstimatorConfig c = base(ModelKind::input_deadzone, 0.001);
   c.guess_left = -2;
   c.guess_right = 2;
-  const AnyEstimator e = estimate(c, r);
+  c.noise.dead_time = dead_time;
+  return c;
+}
+
+void expect_input_deadzone_plant(const AnyEstimator& e) {
   const SideParams pr = e.params(Side::right), pl = e.params(Side::left);
   ASSERT_TRUE(pr.identified && pl.identified);
   EXPECT_NEAR(pr.a1, -0.8, 1e-8);
@@ -402,36 +411,19 @@ TEST(Estimators, InputDeadzoneRecoversItsModel) {
   EXPECT_NEAR(pl.c, -1.5, 1e-7);
 }
 
+TEST(Estimators, InputDeadzoneRecoversItsModel) {
+  expect_input_deadzone_plant(estimate(input_deadzone_config(0), input_deadzone_record(0)));
+}
+
 TEST(Estimators, DeadTimeDelaysTheRegressionAndTheFreeRun) {
   // The plant of InputDeadzoneRecoversItsModel behind a pure delay of 2 samples: y(k) responds
   // to v(k−3). dead_time = 2 recovers it exactly and its free run reproduces y (NRMSE ~ 0);
   // input_delay = 2 (a filter alignment, not part of the model) gives the same estimates but a
   // free run 2 samples ahead; no delay at all leaves the estimates off.
-  auto record = [] {
-    std::vector<Block> b;
-    b.emplace_back(Delay(2));
-    b.emplace_back(Deadzone({-1.5, 0.8}));
-    b.emplace_back(FirstOrder({{-0.8, 0.3}, {-0.7, 0.45}}));
-    SignalSpec in;
-    in.kind = Waveform::triangle;
-    in.amplitude = 5;
-    in.frequency_rad_s = 3;
-    return run_plant(std::move(b), 0.001, in, 10);
-  };
-  const Record r = record();
-  EstimatorConfig c = base(ModelKind::input_deadzone, 0.001);
-  c.guess_left = -2;
-  c.guess_right = 2;
-  c.noise.dead_time = 2;
+  const Record r = input_deadzone_record(2);
+  EstimatorConfig c = input_deadzone_config(2);
   const AnyEstimator dead = estimate(c, r);
-  const SideParams pr = dead.params(Side::right), pl = dead.params(Side::left);
-  ASSERT_TRUE(pr.identified && pl.identified);
-  EXPECT_NEAR(pr.a1, -0.8, 1e-8);
-  EXPECT_NEAR(pr.b1, 0.3, 1e-8);
-  EXPECT_NEAR(pr.c, 0.8, 1e-7);
-  EXPECT_NEAR(pl.a1, -0.7, 1e-8);
-  EXPECT_NEAR(pl.b1, 0.45, 1e-8);
-  EXPECT_NEAR(pl.c, -1.5, 1e-7);
+  expect_input_deadzone_plant(dead);
   const double fit_dead = dead.report().fit_nrmse;
   EXPECT_LT(fit_dead, 1e-6);
   EXPECT_NEAR(dead.simulated(), r.y.back(), 1e-6);
@@ -439,13 +431,12 @@ TEST(Estimators, DeadTimeDelaysTheRegressionAndTheFreeRun) {
   c.noise.dead_time = 0;
   c.noise.input_delay = 2;
   const AnyEstimator aligned = estimate(c, r);
-  EXPECT_EQ(aligned.params(Side::right).a1, pr.a1);  // the same regression, bit for bit
-  EXPECT_EQ(aligned.params(Side::left).c, pl.c);
+  EXPECT_EQ(aligned.params(Side::right).a1, dead.params(Side::right).a1);  // the same regression, bit for bit
+  EXPECT_EQ(aligned.params(Side::left).c, dead.params(Side::left).c);
   EXPECT_GT(aligned.report().fit_nrmse, 100 * fit_dead + 1e-3);  // its free run leads y by 2 samples
 
   c.noise.input_delay = 0;
-  const AnyEstimator none = estimate(c, r);
-  const SideParams nr = none.params(Side::right);
+  const SideParams nr = estimate(c, r).params(Side::right);
   EXPECT_FALSE(nr.identified && std::fabs(nr.b1 - 0.3) < 1e-3 && std::fabs(nr.c - 0.8) < 1e-3);
 
   c.noise.dead_time = 100001;
