@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """The figure of docs/rigs.md "What the first-order model cannot see": runs the lash campaigns E3
 and E4 with `lash sweep` and plots, per identified side,
- - E3 (motor cart): the error of c [%] against the input frequency, one marker per waveform;
+ - E3 (motor cart): the error of c [%] against the input frequency, one marker per waveform (square
+   waves only as they were before verdict check 2's held-level rule: now not_excited, no values);
  - E4 (pilot valve, its solenoid lag taken as a dead time of 2 samples): the identified τ [s] against the run's largest |pressure| [kPa], with the
    rig's τ(p) = τ0/(1 + |p|/p_half), τ(p) plus the solenoid's lag, and τ0 (the sweep's "true" τ).
 Usage: scripts/rigs_identifiability.py LASH OUT.png   (LASH: build/bin/lash)"""

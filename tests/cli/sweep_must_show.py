@@ -97,11 +97,18 @@ if share < 0.94:
     fail.append("E3 (lash settings): share of good runs below the thesis's 94 %")
 # A regression floor, not issue 24's goal (>= 95 %, none above 20 %: docs/sweep.md): the 4-point
 # moving average on the encoder velocity gave 200 of 294 identified sides within 5 % and 11 above
-# 20 % (10-point: 160 and 63; unfiltered: 76 of 288 and 116). The counts were checked against the
-# CSV in check_common.
-if not (s["sides_within_tolerance"] >= 0.65 * ident and s["sides_above_20pct"] <= 12):
+# 20 % (10-point: 160 and 63; unfiltered: 76 of 288 and 116); verdict check 2's held-level rule
+# then reports the square waves' sides not_excited (they hold +-A on >= 92 % of a side's updates)
+# and leaves 169 of 198 within 5 %, 1 above 20 %. The counts were checked against the CSV in
+# check_common.
+if not (s["sides_within_tolerance"] >= 0.84 * ident and s["sides_above_20pct"] <= 1):
     fail.append(f"E3 (lash settings): {s['sides_within_tolerance']}/{ident} identified sides within 5 %, "
-                f"{s['sides_above_20pct']} above 20 % (floor: 65 % and at most 12)")
+                f"{s['sides_above_20pct']} above 20 % (floor: 84 % and at most 1)")
+square_ident = [r["run"] for r in rows if r["waveform"] == "square" and "1" in (r["identified_r"], r["identified_l"])]
+other_open = [r["run"] for r in rows if r["waveform"] != "square" and "1" not in (r["identified_r"], r["identified_l"])]
+if square_ident or other_open:
+    fail.append(f"E3 (lash settings): square-wave runs with a side identified {square_ident[:5]} "
+                f"or other runs with none {other_open[:5]} (a square wave holds one level per side: not_excited)")
 s, rows, _ = sweep("e4_pilot_valve")
 check_common("E4 thesis settings", s, rows, 164)
 s, rows, _ = sweep("e4_pilot_valve_lash")

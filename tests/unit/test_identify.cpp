@@ -464,6 +464,75 @@ TEST(Estimators, OutputDeadzoneRecoversItsModel) {
   EXPECT_NEAR(e.simulated(), r.y.back(), 1e-6);
 }
 
+TEST(Estimators, HeldLevelShareCountedByHand) {
+  // ValueRange (verdict check 2): the updates at the running largest / smallest value.
+  verdict_rules::ValueRange r;
+  for (double x : {5.0, 5.0, 5.0, 1.0, 2.0}) r.add(x);
+  EXPECT_EQ(r.n, 5U);
+  EXPECT_EQ(r.n_hi, 3U);  // three 5s
+  EXPECT_EQ(r.n_lo, 1U);  // one 1
+  EXPECT_DOUBLE_EQ(r.held_share(), 0.6);
+  EXPECT_TRUE(r.varied());
+  r.add(5.0 + 1e-12);  // within rounding of 5: still the same level
+  EXPECT_EQ(r.n_hi, 4U);
+  r.add(7.0);  // a new largest value: its count starts again
+  EXPECT_EQ(r.n_hi, 1U);
+  EXPECT_DOUBLE_EQ(r.held_share(), 1.0 / 7.0);
+  // 19 of 20 at one level: 0.95 > 0.9, several values but not varied
+  verdict_rules::ValueRange sq;
+  for (int k = 0; k < 19; ++k) sq.add(-6.0);
+  sq.add(6.0);
+  EXPECT_TRUE(sq.several());
+  EXPECT_DOUBLE_EQ(sq.held_share(), 0.95);
+  EXPECT_FALSE(sq.varied());
+  // exactly 9 of 10: at the threshold, still varied
+  verdict_rules::ValueRange nine;
+  for (int k = 0; k < 9; ++k) nine.add(3.0);
+  nine.add(2.0);
+  EXPECT_DOUBLE_EQ(nine.held_share(), 0.9);
+  EXPECT_TRUE(nine.varied());
+  EXPECT_DOUBLE_EQ(verdict_rules::ValueRange{}.held_share(), 0.0);
+}
+
+TEST(Estimators, SquareWaveSidesAreNotExcitedStaircaseSidesAre) {
+  // The plant of OutputDeadzoneRecoversItsModel under a square wave of 6 at 4 rad/s: each side
+  // sees its own level ±6 in steady state and the other only while the output decays after a
+  // switch, i.e. far more than 90 % of its updates at one level: not_excited (verdict check 2),
+  // although the noise-free data fit the model exactly (the free run still reproduces them).
+  auto blocks = [] {
+    std::vector<Block> b;
+    b.emplace_back(FirstOrder(PerSide<FirstOrderParams>::both({-0.95, 0.2})));
+    b.emplace_back(Deadzone({-0.5, 0.3}));
+    return b;
+  };
+  SignalSpec sq;
+  sq.kind = Waveform::square;
+  sq.amplitude = 6;
+  sq.frequency_rad_s = 4;
+  const Record r = run_plant(blocks(), 0.002, sq, 10);
+  const AnyEstimator e = estimate(base(ModelKind::output_deadzone, 0.002), r);
+  for (Side s : {Side::right, Side::left}) {
+    EXPECT_FALSE(e.params(s).identified);
+    EXPECT_EQ(e.params(s).reason, Reason::not_excited);
+  }
+  EXPECT_NEAR(e.simulated(), r.y.back(), 1e-6);
+  // A staircase 0, 2, 4, 2, 0, −2, −4, −2 (1 s each, twice): each side holds two levels beyond
+  // its edge, the outer one on about half of its updates — identified exactly.
+  SignalSpec st;
+  st.kind = Waveform::steps;
+  st.amplitude = 1;
+  const double lv[] = {0, 2, 4, 2, 0, -2, -4, -2};
+  for (int k = 0; k < 16; ++k) st.steps.push_back({static_cast<double>(k), lv[k % 8]});
+  const Record r2 = run_plant(blocks(), 0.002, st, 16);
+  const AnyEstimator e2 = estimate(base(ModelKind::output_deadzone, 0.002), r2);
+  const SideParams pr = e2.params(Side::right), pl = e2.params(Side::left);
+  ASSERT_TRUE(pr.identified && pl.identified) << to_string(pr.reason) << " " << to_string(pl.reason);
+  EXPECT_NEAR(pr.b1, 0.2, 1e-8);
+  EXPECT_NEAR(pr.c, 0.3, 1e-6);
+  EXPECT_NEAR(pl.b1, 0.2, 1e-8);
+  EXPECT_NEAR(pl.c, -0.5, 1e-6);
+}
+
 TEST(Estimators, UnstableOrUnphysicalSidesNeverDriveTheFreeRun) {
   // Data of y(k) = 1.002·y(k−1) + 0.001·v(k−1) (a pole outside the unit circle) for v > 0, and
   // nothing for v ≤ 0: the right side's RLS finds a1 = −1.002 exactly, which is neither

@@ -154,7 +154,12 @@ struct EstimatorCore {
     vrange[s].add(v);
     yrange[s].add(y);
   }
-  bool excited(Side s) const noexcept { return vrange[s].several() && yrange[s].several(); }
+  /// Check 2's value tests for a side of a two-sided model: v varied (not held at one level
+  /// on most updates) and y took several values.
+  bool excited(Side s) const noexcept { return vrange[s].varied() && yrange[s].several(); }
+  /// The same for the linear model, whose regression has no offset: v and y took several values
+  /// (a step's one level beyond zero identifies a1 and b1).
+  bool varies(Side s) const noexcept { return vrange[s].several() && yrange[s].several(); }
   /// Verdict check 2's condition test. Least squares: P is the (scaled) inverse information
   /// matrix. Instrumental variables: P = (Σ z φᵀ)⁻¹ is not symmetric and not a covariance, so
   /// the test does not apply (the value-range checks still do).

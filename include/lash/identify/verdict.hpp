@@ -9,7 +9,10 @@
 ///     — else `not_updated`;
 ///  2. it was excited: the input v(k−1) and the output regressor y(k−1) each took more than one
 ///     value over the side's updates (a constant v makes b1 and the offset inseparable, a
-///     constant y leaves a1 undetermined), and the information matrix P⁻¹ of its RLS is well
+///     constant y leaves a1 undetermined), v did not sit at one level (its largest or its
+///     smallest value) on more than 90 % of them (a held input separates b1 and the offset
+///     only in the transients after its switches: ValueRange::varied), and the information
+///     matrix P⁻¹ of its RLS is well
 ///     conditioned (checked by `verdict()`, see `well_conditioned`) — else `not_excited`;
 ///  3. it is stable: finite and |a1| < 1 — else `unstable`;
 ///  4. it is physical: b1 > 0, the deadzone edge on its own side of zero (c_r ≥ 0 ≥ c_l:
@@ -26,6 +29,7 @@
 ///  8. only with `ci_tolerance` > 0 (config.hpp; off by default), where intervals are computed:
 ///     the side has intervals, and those of K, τ, c and d each lie within ±ci_tolerance of their
 ///     centre — else `uncertain` (precision_verdict).
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -62,16 +66,46 @@ namespace verdict_rules {
 /// The deadzone edge c of `s` lies on its own side of zero: c_r ≥ 0, c_l ≤ 0.
 constexpr bool physical_edge(double c, Side s) noexcept { return s == Side::right ? c >= 0.0 : c <= 0.0; }
 
-/// The range of the values one regressor took (excitation check).
+/// The range of the values one regressor took (excitation check), and how many of them sat at
+/// its extremes (the held-level check).
 struct ValueRange {
   double lo = std::numeric_limits<double>::infinity();
   double hi = -std::numeric_limits<double>::infinity();
+  std::uint64_t n = 0;     ///< values seen
+  std::uint64_t n_lo = 0;  ///< of them at lo (within rounding), since lo last fell beyond it
+  std::uint64_t n_hi = 0;  ///< of them at hi (within rounding), since hi last rose beyond it
   void add(double x) noexcept {
-    lo = std::min(lo, x);
-    hi = std::max(hi, x);
+    const double tol = 1e-9 * std::max(1.0, std::fabs(x));
+    ++n;
+    if (x > hi + tol) {
+      hi = x;
+      n_hi = 1;
+    } else if (x >= hi - tol) {
+      ++n_hi;
+    }
+    if (x < lo - tol) {
+      lo = x;
+      n_lo = 1;
+    } else if (x <= lo + tol) {
+      ++n_lo;
+    }
   }
   /// More than one value (beyond rounding) was seen.
   bool several() const noexcept { return hi - lo > 1e-9 * std::max(1.0, std::max(std::fabs(hi), std::fabs(lo))); }
+  /// The share of the values that sat at one extreme, the larger of the two (0 when none was
+  /// seen). A side whose input held one level (a square wave's ±A, a binary PRBS, a step) has
+  /// most of its updates there; a sine, a triangle, a multisine or random levels have a few %.
+  double held_share() const noexcept {
+    return n == 0 ? 0.0 : static_cast<double>(std::max(n_lo, n_hi)) / static_cast<double>(n);
+  }
+  /// Several values, and no extreme held by more than `kMaxHeldShare` of them (check 2).
+  bool varied() const noexcept { return several() && held_share() <= kMaxHeldShare; }
+  /// Above this share of a side's updates at one input level the side is not excited: b1 and
+  /// the edge's offset are then told apart by less than a tenth of its samples, the transients
+  /// after the input's switches, where the fast dynamics the first-order model lacks sit
+  /// (docs/method.md §A4.7). Measured: square waves 0.92–1, sines, triangles and random inputs
+  /// at most 0.003; a few random levels per side (the monitor's 3 s sections) stay below it.
+  static constexpr double kMaxHeldShare = 0.9;
 };
 
 /// What the update-time checks (1–5) see of one side.

@@ -32,7 +32,7 @@ void LinearModel::free_run(EstimatorCore& c) noexcept {
 verdict_rules::Evidence LinearModel::evidence(const EstimatorCore& c, Side) const noexcept {
   verdict_rules::Evidence ev;
   ev.updated = rls_.updates() >= c.cfg.min_updates;
-  ev.excited = c.excited(Side::right);
+  ev.excited = c.varies(Side::right);
   ev.a1 = rls_.eta(0);
   ev.b1 = rls_.eta(1);
   return ev;
