@@ -61,6 +61,7 @@ constexpr double deadzone(double x, double cl, double cr) noexcept {
   return x > cr ? x - cr : (x < cl ? x - cl : 0.0);
 }
 using ValueRange = verdict_rules::ValueRange;
+using Extent = verdict_rules::Extent;
 /// Samples after a restart() before a regression may use a sample again: the preprocessor's
 /// memory, the previous samples y(k−1), y(k−2) and, for IV, the instrument's delay.
 inline std::uint32_t warmup_samples(const EstimatorConfig& c, const Preprocessor& p) noexcept {
@@ -130,7 +131,8 @@ struct EstimatorCore {
   /// moving average's start-up ramp would make a constant input take several values).
   std::uint64_t start = 0;
   detail::History hist;                // y(k−1), y(k−2), … after the preprocessing (the IV instrument)
-  PerSide<detail::ValueRange> vrange{}, yrange{};  // v(k−1), y(k−1) over each side's updates
+  PerSide<detail::ValueRange> vrange{};  // v(k−1) over each side's updates, with its held levels
+  PerSide<detail::Extent> yrange{};      // y(k−1) over each side's updates
   detail::FitWindow fit;
   double y1 = 0.0, v1 = 0.0;  // the previous conditioned sample
   double vraw1 = 0.0;         // the previous raw v, delayed by the dead time (the free run's input)

@@ -66,11 +66,21 @@ namespace verdict_rules {
 /// The deadzone edge c of `s` lies on its own side of zero: c_r ≥ 0, c_l ≤ 0.
 constexpr bool physical_edge(double c, Side s) noexcept { return s == Side::right ? c >= 0.0 : c <= 0.0; }
 
-/// The range of the values one regressor took (excitation check), and how many of them sat at
-/// its extremes (the held-level check).
-struct ValueRange {
+/// The range of the values one regressor took (the excitation check's value test).
+struct Extent {
   double lo = std::numeric_limits<double>::infinity();
   double hi = -std::numeric_limits<double>::infinity();
+  void add(double x) noexcept {
+    lo = std::min(lo, x);
+    hi = std::max(hi, x);
+  }
+  /// More than one value (beyond rounding) was seen.
+  bool several() const noexcept { return hi - lo > 1e-9 * std::max(1.0, std::max(std::fabs(hi), std::fabs(lo))); }
+};
+
+/// The range of the values one regressor took (excitation check), and how many of them sat at
+/// its extremes (the held-level check).
+struct ValueRange : Extent {
   std::uint64_t n = 0;     ///< values seen
   std::uint64_t n_lo = 0;  ///< of them at lo (within rounding), since lo last fell beyond it
   std::uint64_t n_hi = 0;  ///< of them at hi (within rounding), since hi last rose beyond it
@@ -90,8 +100,6 @@ struct ValueRange {
       ++n_lo;
     }
   }
-  /// More than one value (beyond rounding) was seen.
-  bool several() const noexcept { return hi - lo > 1e-9 * std::max(1.0, std::max(std::fabs(hi), std::fabs(lo))); }
   /// The share of the values that sat at one extreme, the larger of the two (0 when none was
   /// seen). A side whose input held one level (a square wave's ±A, a binary PRBS, a step) has
   /// most of its updates there; a sine, a triangle, a multisine or random levels have a few %.
