@@ -60,6 +60,7 @@ class Estimator {
     EstimateSettings set = resolve_settings(sources(model, preset, tbl), dt_s);
     cfg_ = set.cfg;
     job_ = set.job;
+    refuse_output_error_online(cfg_, "lash.estimate (a whole record)");
     est_ = std::make_unique<AnyEstimator>(cfg_);
     gaps_.emplace(cfg_.dt_s);
     make_reguesser();

@@ -8,6 +8,7 @@ import math
 import os
 
 import numpy as np
+import pytest
 
 import lash
 from conftest import E2_SETTINGS, SRC, read_csv, run_lash, write_settings_toml
@@ -120,7 +121,9 @@ def test_default_preset_is_lash_everywhere(e2_csv):
     """One default preset: lash.Estimator, lash.estimate and `lash estimate` all default to 'lash'.
     The streaming Estimator runs lash's static settings; given the settings `lash estimate
     --print-config` chose from the record, it is lash.estimate (gate off, same guesses) bit for bit,
-    fed in chunks; the thesis preset is another estimator."""
+    fed in chunks, up to the output-error refinement, which only a whole record allows (it is
+    refused online, and chosen for a record: print-config says output_error = true); the thesis
+    preset is another estimator."""
     import tomllib
     d = read_csv(e2_csv)
     t, v, y = d["t"], d["v"], d["y"]
@@ -132,20 +135,29 @@ def test_default_preset_is_lash_everywhere(e2_csv):
     assert cli["preset"] == "lash"
     chosen = tomllib.loads(run_lash("estimate", e2_csv, "--model", "deadzone-deadband", "--guess-left", "-350",
                                     "--guess-right", "350", "--outlier-gate", "0", "--print-config"))
+    assert chosen["output_error"] is True and batch.to_dict()["output_error"]["used"]
     thr = chosen["noise"]["derivative_threshold"]
     assert thr != 150.0  # tuned to the record, not the static value
     stream = lash.Estimator("deadzone-deadband", batch.dt_s, **guesses, noise={"derivative_threshold": thr})
     yhat = np.concatenate([stream.update_many(v[i:i + 3001], y[i:i + 3001], t=t[i:i + 3001])
                            for i in range(0, len(t), 3001)])
     assert yhat.tobytes() == batch.yhat.tobytes()
-    assert stream.result().json == batch.json
+    switching = lash.estimate(t, v, y, outlier_gate=0, output_error=False, **guesses)
+    assert stream.result().json == switching.json
+    with pytest.raises(ValueError, match="output-error"):
+        lash.Estimator("deadzone-deadband", batch.dt_s, output_error=True)
     thesis = lash.Estimator("deadzone-deadband", batch.dt_s, preset="thesis", **guesses)
     assert thesis.update_many(v, y, t=t).tobytes() != yhat.tobytes()
 
 
 def test_trace_columns(e2_csv):
     d = read_csv(e2_csv)
-    r = lash.estimate(d["t"], d["v"], d["y"], trace=True, **E2_SETTINGS)
+    # the trace is the recursion's: its last row is the report's without the output-error refinement
+    r = lash.estimate(d["t"], d["v"], d["y"], trace=True, output_error=False, **E2_SETTINGS)
     assert list(r.params) == ["a1_r", "b1_r", "c_r", "d_r", "a1_l", "b1_l", "c_l", "d_l"]
     assert math.isnan(r.params["c_r"][0])
     assert r.params["c_r"][-1] == r.to_dict()["right"]["c"]
+    refined = lash.estimate(d["t"], d["v"], d["y"], trace=True, **E2_SETTINGS)
+    assert refined.params["c_r"].tobytes() == r.params["c_r"].tobytes()
+    assert refined.to_dict()["right"]["c"] != r.to_dict()["right"]["c"]
+    assert abs(refined.to_dict()["right"]["c"] / 200.0 - 1) < 0.01  # E2's right edge

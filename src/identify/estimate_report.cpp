@@ -295,6 +295,20 @@ std::string estimate_auto_json(const AutoRun& ar, Preset preset, const ReportFit
         sw["model"][name] = {{"a1", num(sd->a1)}, {"b1", num(sd->b1)}, {"c", num(sd->c)}, {"d", num(sd->d)}};
     j["model_switching"] = sw;
   }
+  if (ar.output_error.tried) {
+    const OutputErrorReport& oe = ar.output_error;
+    Json o{{"used", oe.used}};
+    if (oe.used)
+      o.update({{"converged", oe.fit.converged},
+                {"passes", oe.fit.passes},
+                {"steps", oe.fit.steps},
+                {"residuals", oe.fit.n},
+                {"rms_start", num(oe.fit.rms_start)},
+                {"rms", num(oe.fit.rms)}});
+    else
+      o["why_not"] = oe.why_not;
+    j["output_error"] = o;
+  }
   j["preset"] = to_string(preset);
   return j.dump();
 }
@@ -321,6 +335,13 @@ std::string estimate_auto_text(const AutoRun& ar, double dt_s, const ReportFit& 
                            ? "; tried because the dy/dt switching's estimate had no 95 % interval"
                        : ar.switching.trigger == SwitchTrigger::check ? "; run to check the dy/dt switching's estimate"
                                                                       : "");
+  if (ar.output_error.tried) {
+    const OutputErrorReport& oe = ar.output_error;
+    out += oe.used ? fmt::format("output error: {} after {} passes ({} steps), free-run rms {:.6g} -> {:.6g}\n",
+                                 oe.fit.converged ? "converged" : "did not converge", oe.fit.passes, oe.fit.steps,
+                                 oe.fit.rms_start, oe.fit.rms)
+                   : fmt::format("output error: not used ({})\n", oe.why_not);
+  }
   return out;
 }
 

@@ -8,6 +8,7 @@
 
 #include "lash/identify/estimate_report.hpp"
 #include "lash/identify/intervals.hpp"
+#include "lash/identify/output_error.hpp"
 #include "lash/io/error.hpp"
 
 namespace lash::monitor {
@@ -33,6 +34,7 @@ OnlineEstimator::OnlineEstimator(const SettingsSources& src, const OnlineSetting
     throw InputError("", 0, "model-switching",
                      "needs --estimate window: model switching iterates over a whole window, the online "
                      "estimator cannot");
+  refuse_output_error_online(resolve_settings(src).cfg, "--estimate window (whole windows)");
   OutlierGateConfig gc;
   gc.gate = s.outlier_gate;
   gate_ = OutlierGate(gc);

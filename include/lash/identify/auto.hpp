@@ -22,6 +22,7 @@
 #include "lash/identify/any_estimator.hpp"
 #include "lash/identify/config.hpp"
 #include "lash/identify/intervals.hpp"
+#include "lash/identify/output_error.hpp"
 
 namespace lash {
 
@@ -127,6 +128,7 @@ struct AutoRun {
   /// The batch-means intervals of the final run's estimate when estimate_auto computed them
   /// already (the check of a ẏ result, SwitchingReport::trigger): add_intervals need not run again.
   std::optional<PerSide<SideIntervals>> ci95;
+  OutputErrorReport output_error;  ///< the output-error refinement (refine_by_output_error)
 };
 
 struct AutoOptions {

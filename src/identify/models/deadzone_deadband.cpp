@@ -48,6 +48,8 @@ void DeadzoneDeadbandModel::tune(EstimatorConfig& c, const DataTraits& d) {
   const double noise = 3.0 * d.noise_sigma * std::sqrt(h2);
   const double quant = d.quantum > 0.0 ? d.quantum / (m2 * c.dt_s) : 0.0;
   c.noise.derivative_threshold = std::max({noise, quant, kRateShare * d.ydot_p90});
+  // a whole record: the switching estimate is refined by output error (docs/method.md §A4.8)
+  c.output_error = true;
 }
 
 DeadzoneDeadbandModel::DeadzoneDeadbandModel(const EstimatorConfig& cfg)

@@ -1,0 +1,105 @@
+#pragma once
+/// @file output_error.hpp
+/// Output-error refinement of a deadzone-deadband estimate over a whole record (docs/method.md
+/// §A4.8): the eight parameters θ = (a1, b1, c, d) of each side are moved to minimise the sum
+/// of squares of y − y_sim(θ), the free run of the model driven by v alone (the verdict's
+/// simulation, eq. 36 of the thesis with the free-run side rule of §A4.2), by Levenberg–Marquardt
+/// from the switching estimate. Why: the switching RLS regresses y(k) on the measured y(k−1);
+/// with measurement noise that regressor is noisy (errors in variables), its instruments are
+/// weak where the pole is near 1 (b1 = K(1 + a1): a1 off by 3·10⁻⁴ moves b1 by 3 % at
+/// τ = 0.17 s, 5 ms), and in closed loop v(k−1) carries the noise of y(k−1). The free run
+/// depends on v only, so with white measurement noise its minimiser is the maximum-likelihood
+/// estimate, consistent in open and in closed loop when the plant is strictly proper (v(k−1)
+/// depends on the noise up to k−1 only; Ljung, System Identification, 2nd ed. 1999, §13.4,
+/// the direct approach), and its covariance is σ²(JᵀJ)⁻¹ (ibid. §9.3).
+///
+/// Memory does not grow with the record: every iteration is one pass over its rows (for_chunks:
+/// a spilled record streams), running the model at θ and at each of the eight forward-difference
+/// points side by side and summing JᵀJ, Jᵀr and rᵀr on the way (O(8²)). Not real-time safe
+/// (whole-record passes); the per-sample estimators never use it.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+#include "lash/identify/record_columns.hpp"
+
+namespace lash {
+
+/// θ in this order: a1_r, b1_r, c_r, d_r, a1_l, b1_l, c_l, d_l.
+using OutputErrorParams = std::array<double, 8>;
+
+struct OutputErrorOptions {
+  std::size_t begin = 0;       ///< first row whose residual is summed (the fit window's start)
+  std::size_t end = 0;         ///< one past the last (0: the record's end)
+  int max_passes = 40;         ///< passes over the record at most
+  bool side_by_sign = false;   ///< the free run's side by the sign of v (EstimatorConfig::sim_side_by_sign)
+  /// Rows (ascending) whose y the fit reads from `edit_values` instead (the outlier gate's
+  /// replacements, gate_outliers): an outlier would pull a least-squares fit.
+  std::span<const std::size_t> edit_rows;
+  std::span<const double> edit_values;
+};
+
+struct OutputErrorFit {
+  bool ok = false;             ///< a finite start, enough rows, and every pass finite
+  bool converged = false;      ///< the cost stopped falling (relative 1e-10) before max_passes
+  int passes = 0;              ///< passes over the record
+  int steps = 0;               ///< accepted Levenberg–Marquardt steps
+  std::size_t n = 0;           ///< residuals summed
+  double rms_start = 0.0;      ///< RMS of y − y_sim at the start [y unit]
+  double rms = 0.0;            ///< at the result [y unit]
+  double rms_given = 0.0;      ///< at the result, against y as given (no edits) [y unit]
+  double y_peak = 0.0;         ///< max |y| (as given) over the residuals' rows (the NRMSE's scale) [y unit]
+  OutputErrorParams theta{};   ///< the result (the start when !ok)
+  /// 95 % half-widths of θ: 1.96·√diag(σ̂²(JᵀJ)⁻¹), σ̂² = rᵀr/(n − 8); NaN where JᵀJ is singular.
+  OutputErrorParams half95{};
+  /// The covariance σ̂²(JᵀJ)⁻¹ of (a1, b1) per side ({var a1, cov, var b1}; right, left): the
+  /// intervals of K = b1/(1 + a1) and τ by the delta method.
+  std::array<std::array<double, 3>, 2> ab_cov{};
+};
+
+/// The model's free run at θ from rest (w = y_sim = 0, the right side first), one sample at a
+/// time: y_sim(k) from v up to k − 1, as the estimators' free run (docs/method.md §A4.2).
+struct FreeRunDzDb {
+  OutputErrorParams th{};
+  bool by_sign = false;
+  double w = 0.0, y = 0.0;
+  bool right = true;
+  /// y_sim(k) given v(k − 1).
+  double step(double v1) noexcept;
+};
+
+/// Levenberg–Marquardt over the record's columns from `start` (a1 within (−1, 1), b1 > 0,
+/// c_r ≥ 0 ≥ c_l, d ≥ 0 are kept: a step that leaves them is shortened by more damping).
+OutputErrorFit fit_output_error(const RecordColumns& record, const OutputErrorParams& start,
+                                const OutputErrorOptions& options = {});
+
+/// What the refinement of a run did (AutoRun::output_error; the JSON's "output_error").
+struct OutputErrorReport {
+  bool tried = false;          ///< the setting was on and the model is deadzone-deadband
+  bool used = false;           ///< the refined parameters replaced the switching estimate's
+  const char* why_not = "";    ///< when tried and not used: why (a fixed text)
+  OutputErrorFit fit;
+};
+
+struct AutoRun;
+struct EstimatorConfig;
+
+/// Estimators fed sample by sample (lash monitor's, Python's Estimator) refuse output_error:
+/// InputError naming `output-error` when it is on (`where`: what the user should use instead).
+void refuse_output_error_online(const EstimatorConfig& cfg, const char* where);
+
+/// With cfg.output_error on a deadzone-deadband run: fits rows [begin, end) of `record` from the
+/// run's estimate and, when the fit is ok, puts its parameters (and K, τ) in the report, the free
+/// run's NRMSE over those rows in the report's fit and the run's score, and judges the sides whose
+/// verdict was about the estimate (identified, uncertain or poor_fit: checks 3–6 again on the new
+/// values); sides refused for their input (not_updated, not_excited, ...) keep their reason. With
+/// `intervals`, the fit's 95 % intervals replace the batch means' and checks 7–8 run on them.
+/// Not used (why_not says why): a dead time, a side without finite parameters, a start the free
+/// run cannot hold, or a fit that failed.
+/// `gate`: the outlier gate's threshold of the run (AutoOptions::gate; 0 = off): the fit reads y
+/// with the gate's replacements, the NRMSE is taken against y as given.
+void refine_by_output_error(AutoRun& run, const RecordColumns& record, std::size_t begin, std::size_t end,
+                            bool intervals, double gate);
+
+}  // namespace lash

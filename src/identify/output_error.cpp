@@ -1,0 +1,340 @@
+#include "lash/identify/output_error.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "lash/identify/auto.hpp"
+#include "lash/io/error.hpp"
+#include "lash/identify/estimator_skeleton.hpp"
+#include "lash/metrics/first_order.hpp"
+
+namespace lash {
+
+namespace {
+
+constexpr std::size_t P = 8;
+using Mat = std::array<std::array<double, P>, P>;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+/// Solves A x = b for a symmetric positive definite A by Cholesky; false when A is not.
+bool cholesky_solve(Mat a, OutputErrorParams b, OutputErrorParams& x) noexcept {
+  for (std::size_t j = 0; j < P; ++j) {
+    double s = a[j][j];
+    for (std::size_t k = 0; k < j; ++k) s -= a[j][k] * a[j][k];
+    if (!(s > 0.0) || !std::isfinite(s)) return false;
+    a[j][j] = std::sqrt(s);
+    for (std::size_t i = j + 1; i < P; ++i) {
+      double t = a[i][j];
+      for (std::size_t k = 0; k < j; ++k) t -= a[i][k] * a[j][k];
+      a[i][j] = t / a[j][j];
+    }
+  }
+  for (std::size_t i = 0; i < P; ++i) {  // L z = b
+    for (std::size_t k = 0; k < i; ++k) b[i] -= a[i][k] * b[k];
+    b[i] /= a[i][i];
+  }
+  for (std::size_t i = P; i-- > 0;) {  // Lᵀ x = z
+    for (std::size_t k = i + 1; k < P; ++k) b[i] -= a[k][i] * b[k];
+    b[i] /= a[i][i];
+  }
+  x = b;
+  return true;
+}
+
+/// a1 in (−1, 1), b1 > 0, c_r ≥ 0 ≥ c_l, d ≥ 0, all finite: a model the free run may hold.
+bool admissible(const OutputErrorParams& t) noexcept {
+  for (double x : t)
+    if (!std::isfinite(x)) return false;
+  return std::fabs(t[0]) < 1.0 && std::fabs(t[4]) < 1.0 && t[1] > 0.0 && t[5] > 0.0 && t[2] >= 0.0 &&
+         t[6] <= 0.0 && t[3] >= 0.0 && t[7] >= 0.0;
+}
+
+/// One pass: rᵀr at θ and, with `jacobian`, JᵀJ and Jᵀr by forward differences of step h.
+struct Pass {
+  double sse = 0.0;
+  Mat jtj{};
+  OutputErrorParams jtr{};
+  std::size_t n = 0;
+  double y_peak = 0.0;
+  double sse_given = 0.0;  // against y as given
+};
+
+Pass run_pass(const RecordColumns& rec, const OutputErrorParams& th, const OutputErrorParams& h, bool jacobian,
+              const OutputErrorOptions& o, std::size_t end) {
+  std::array<FreeRunDzDb, P + 1> m;
+  for (std::size_t i = 0; i <= P; ++i) {
+    m[i].th = th;
+    m[i].by_sign = o.side_by_sign;
+    if (i > 0) m[i].th[i - 1] += h[i - 1];
+  }
+  const std::size_t models = jacobian ? P + 1 : 1;
+  Pass p;
+  double v1 = 0.0;
+  std::size_t next_edit = 0;
+  for_chunks(rec.store, rec.vy, 0, end, [&](std::size_t base, const auto& cols) {
+    const auto& v = cols[0];
+    const auto& y = cols[1];
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      std::array<double, P + 1> ys{};
+      for (std::size_t i = 0; i < models; ++i) ys[i] = m[i].step(v1);
+      v1 = v[k];
+      if (base + k < o.begin || !std::isfinite(y[k]) || !std::isfinite(v[k])) {
+        if (!std::isfinite(v1)) v1 = 0.0;  // a missing input drives nothing
+        continue;
+      }
+      double yk = y[k];
+      while (next_edit < o.edit_rows.size() && o.edit_rows[next_edit] < base + k) ++next_edit;
+      if (next_edit < o.edit_rows.size() && o.edit_rows[next_edit] == base + k) yk = o.edit_values[next_edit];
+      const double r = yk - ys[0];
+      p.sse += r * r;
+      p.sse_given += (y[k] - ys[0]) * (y[k] - ys[0]);
+      p.y_peak = std::max(p.y_peak, std::fabs(y[k]));
+      ++p.n;
+      if (!jacobian) continue;
+      OutputErrorParams g;  // ∂y_sim/∂θ
+      for (std::size_t i = 0; i < P; ++i) g[i] = (ys[i + 1] - ys[0]) / h[i];
+      for (std::size_t i = 0; i < P; ++i) {
+        p.jtr[i] += g[i] * r;
+        for (std::size_t j = 0; j <= i; ++j) p.jtj[i][j] += g[i] * g[j];
+      }
+    }
+  });
+  for (std::size_t i = 0; i < P; ++i)
+    for (std::size_t j = i + 1; j < P; ++j) p.jtj[i][j] = p.jtj[j][i];
+  return p;
+}
+
+}  // namespace
+
+double FreeRunDzDb::step(double v1) noexcept {
+  const PerSide<double> edge{th[2], th[6]};
+  const Side s = detail::free_run_side(v1, edge, right ? Side::right : Side::left, by_sign);
+  right = s == Side::right;
+  const double u = detail::deadzone(v1, th[6], th[2]);
+  const std::size_t o = right ? 0 : 4;
+  w = -th[o] * w + th[o + 1] * u;
+  const double d = th[o + 3];
+  if (w < y - d) y = w + d;
+  else if (w > y + d) y = w - d;
+  return y;
+}
+
+OutputErrorFit fit_output_error(const RecordColumns& rec, const OutputErrorParams& start,
+                                const OutputErrorOptions& o) {
+  OutputErrorFit f;
+  f.theta = start;
+  f.half95.fill(kNaN);
+  for (auto& c : f.ab_cov) c.fill(kNaN);
+  const std::size_t end = o.end == 0 ? rec.size() : std::min(o.end, rec.size());
+  if (!admissible(start) || end <= o.begin || end - o.begin <= 2 * P) return f;
+  // forward-difference steps: relative to each parameter's scale (a1: its distance to ±1 matters)
+  const double cscale = std::max({std::fabs(start[2]), std::fabs(start[6]), 1e-12});
+  OutputErrorParams h{};
+  for (std::size_t s = 0; s < 2; ++s) {
+    const std::size_t b = 4 * s;
+    h[b] = 1e-7 * std::max(1.0 - std::fabs(start[b]), 1e-6);
+    h[b + 1] = 1e-7 * std::fabs(start[b + 1]);
+    h[b + 2] = 1e-7 * cscale;
+    h[b + 3] = 1e-7 * std::max(std::fabs(start[b + 3]), 1e-3 * cscale);
+  }
+  OutputErrorParams theta = start;
+  Pass cur = run_pass(rec, theta, h, true, o, end);
+  f.passes = 1;
+  if (!std::isfinite(cur.sse) || cur.n <= P) return f;
+  f.rms_start = std::sqrt(cur.sse / static_cast<double>(cur.n));
+  double mu = 1e-3;
+  while (f.passes < o.max_passes) {
+    // (JᵀJ + μ diag JᵀJ) δ = Jᵀr (r = y − y_sim, so θ + δ lowers rᵀr to first order)
+    OutputErrorParams delta{}, next{};
+    bool found = false;
+    for (int tries = 0; tries < 30 && !found; ++tries) {
+      Mat a = cur.jtj;
+      for (std::size_t i = 0; i < P; ++i) a[i][i] *= 1.0 + mu;
+      if (!cholesky_solve(a, cur.jtr, delta)) {
+        mu *= 10.0;
+        continue;
+      }
+      for (std::size_t i = 0; i < P; ++i) next[i] = theta[i] + delta[i];
+      if (admissible(next)) found = true;
+      else mu *= 10.0;
+    }
+    if (!found) break;
+    Pass cand = run_pass(rec, next, h, true, o, end);
+    ++f.passes;
+    if (std::isfinite(cand.sse) && cand.sse < cur.sse) {
+      const double gain = (cur.sse - cand.sse) / cur.sse;
+      theta = next;
+      cur = cand;
+      ++f.steps;
+      mu = std::max(mu / 10.0, 1e-12);
+      if (gain < 1e-10) {
+        f.converged = true;
+        break;
+      }
+    } else {
+      mu *= 10.0;
+      if (mu > 1e12) {  // no step lowers the cost: θ is a minimum to the precision of the differences
+        f.converged = true;
+        break;
+      }
+    }
+  }
+  f.ok = true;
+  f.theta = theta;
+  f.n = cur.n;
+  f.rms = std::sqrt(cur.sse / static_cast<double>(cur.n));
+  f.y_peak = cur.y_peak;
+  f.rms_given = std::sqrt(cur.sse_given / static_cast<double>(cur.n));
+  // covariance σ̂²(JᵀJ)⁻¹ at the result
+  const double s2 = cur.sse / static_cast<double>(cur.n - P);
+  Mat inv{};
+  bool regular = true;
+  for (std::size_t j = 0; j < P && regular; ++j) {
+    OutputErrorParams e{}, col{};
+    e[j] = 1.0;
+    regular = cholesky_solve(cur.jtj, e, col);
+    for (std::size_t i = 0; i < P; ++i) inv[i][j] = col[i];
+  }
+  if (regular) {
+    for (std::size_t i = 0; i < P; ++i) f.half95[i] = 1.96 * std::sqrt(std::max(0.0, s2 * inv[i][i]));
+    for (std::size_t s = 0; s < 2; ++s) {
+      const std::size_t b = 4 * s;
+      f.ab_cov[s] = {s2 * inv[b][b], s2 * inv[b][b + 1], s2 * inv[b + 1][b + 1]};
+    }
+  }
+  return f;
+}
+
+namespace {
+/// The 95 % intervals of one side from the fit: ±half95 around a1, b1, c, d; K and τ by the delta
+/// method from the (a1, b1) covariance (K = b1/(1 + a1), τ = −T/ln(−a1)).
+SideIntervals fit_intervals(const OutputErrorFit& f, std::size_t side, double dt_s) {
+  const std::size_t b = 4 * side;
+  const auto iv = [](double c, double h) { return std::isfinite(h) ? Interval{c - h, c + h} : Interval{}; };
+  SideIntervals ci;
+  ci.a1 = iv(f.theta[b], f.half95[b]);
+  ci.b1 = iv(f.theta[b + 1], f.half95[b + 1]);
+  ci.c = iv(f.theta[b + 2], f.half95[b + 2]);
+  ci.d = iv(f.theta[b + 3], f.half95[b + 3]);
+  const double a1 = f.theta[b], b1 = f.theta[b + 1];
+  const auto& [vaa, vab, vbb] = f.ab_cov[side];
+  const double ka = -b1 / ((1.0 + a1) * (1.0 + a1)), kb = 1.0 / (1.0 + a1);
+  const double var_k = ka * ka * vaa + 2.0 * ka * kb * vab + kb * kb * vbb;
+  if (std::isfinite(var_k)) ci.K = iv(static_gain(a1, b1), 1.96 * std::sqrt(std::max(0.0, var_k)));
+  const double tau = time_constant_s(a1, dt_s);
+  if (std::isfinite(tau)) {
+    const double l = std::log(-a1);
+    const double ta = dt_s / (a1 * l * l);  // dτ/da1
+    const double var_t = ta * ta * vaa;
+    if (std::isfinite(var_t)) ci.tau_s = iv(tau, 1.96 * std::sqrt(var_t));
+  }
+  return ci;
+}
+}  // namespace
+
+void refuse_output_error_online(const EstimatorConfig& cfg, const char* where) {
+  if (cfg.output_error)
+    throw InputError("", 0, "output-error",
+                     std::string("the output-error refinement iterates over a whole record, an estimator fed sample "
+                                 "by sample cannot; use ") +
+                         where);
+}
+
+void refine_by_output_error(AutoRun& ar, const RecordColumns& rec, std::size_t begin, std::size_t end,
+                            bool intervals, double gate) {
+  OutputErrorReport& out = ar.output_error;
+  out = {};
+  const EstimatorConfig& cfg = ar.cfg;
+  if (!cfg.output_error || cfg.model != ModelKind::deadzone_deadband) return;
+  out.tried = true;
+  if (cfg.noise.dead_time != 0) {
+    out.why_not = "the model has a dead time (the free run of the refinement has none)";
+    return;
+  }
+  EstimateReport& rep = ar.run.report;
+  // the start: the sides' estimates; a side without one (a check on its values or its updates
+  // failed) starts from the other side's dynamics and deadband with its edge mirrored (the free
+  // run needs every parameter). A side not excited (its input held one level or one value) is
+  // not refined: its parameters are not told apart by the record.
+  const auto finite = [](const SideParams& p) {
+    return std::isfinite(p.a1) && std::isfinite(p.b1) && std::isfinite(p.c) && std::isfinite(p.d);
+  };
+  OutputErrorParams start{};
+  for (const Side s : {Side::right, Side::left}) {
+    const SideParams& p = rep[s].params;
+    const SideParams& q = rep[s == Side::right ? Side::left : Side::right].params;
+    const std::size_t b = s == Side::right ? 0 : 4;
+    if (p.reason == Reason::not_excited) {
+      out.why_not = "a side is not excited (its input held one level or one value)";
+      return;
+    }
+    if (finite(p)) start[b] = p.a1, start[b + 1] = p.b1, start[b + 2] = p.c, start[b + 3] = p.d;
+    else if (finite(q)) start[b] = q.a1, start[b + 1] = q.b1, start[b + 2] = -q.c, start[b + 3] = q.d;
+    else {
+      out.why_not = "neither side has an estimate to start from";
+      return;
+    }
+  }
+  OutputErrorOptions o;
+  o.begin = begin;
+  o.end = end;
+  std::vector<std::size_t> edit_rows;
+  std::vector<double> edit_values;
+  if (ar.outliers > 0) gate_outliers(rec, gate, edit_rows, edit_values);  // the run's replacements again
+  o.edit_rows = edit_rows;
+  o.edit_values = edit_values;
+  o.side_by_sign = true;  // the plant's structure (eq. 34, blocks/deadband.hpp): the side of the sign of v(k−1)
+  out.fit = fit_output_error(rec, start, o);
+  const OutputErrorFit& f = out.fit;
+  if (!f.ok) {
+    out.why_not = admissible(start) ? "the fit failed (too few rows in the window, or a non-finite pass)"
+                                    : "the estimate is not one the free run can hold (|a1| >= 1, b1 <= 0 or an edge "
+                                      "on the wrong side of zero)";
+    return;
+  }
+  out.used = true;
+  const NrmseAccumulator score{f.rms_given * f.rms_given * static_cast<double>(f.n), f.y_peak, f.n};
+  rep.fit_nrmse = score.value();
+  ar.run.score = score;
+  rep.identified = true;
+  for (const Side s : {Side::right, Side::left}) {
+    SideReport& r = rep[s];
+    const std::size_t b = s == Side::right ? 0 : 4;
+    r.params.a1 = f.theta[b], r.params.b1 = f.theta[b + 1], r.params.c = f.theta[b + 2], r.params.d = f.theta[b + 3];
+    r.K = static_gain(r.params.a1, r.params.b1);
+    r.tau_s = time_constant_s(r.params.a1, cfg.dt_s);
+    {  // checks 3–6 again on the new values; check 2 on the fit's information (JᵀJ)
+      verdict_rules::Evidence e;
+      e.side = s;
+      e.updated = true;
+      e.excited = std::isfinite(f.half95[b]) && std::isfinite(f.half95[b + 1]) && std::isfinite(f.half95[b + 2]) &&
+                  std::isfinite(f.half95[b + 3]);
+      e.a1 = r.params.a1, e.b1 = r.params.b1, e.c = r.params.c, e.d = r.params.d;
+      e.has_c = e.has_d = true;
+      r.params.reason = verdict_rules::finish(verdict_rules::judge(e), true, rep.fit_nrmse, cfg.fit_threshold);
+      r.params.identified = r.params.reason == Reason::none;
+    }
+    r.ci95 = {};
+    if (!r.params.identified) rep.identified = false;
+  }
+  if (intervals)
+    attach_intervals(rep, {fit_intervals(f, 0, cfg.dt_s), fit_intervals(f, 1, cfg.dt_s)}, cfg.ci_tolerance);
+  if (!ar.run.ysim.empty()) {  // the stored free run: the refined model's
+    FreeRunDzDb m;
+    m.th = f.theta;
+    m.by_sign = cfg.sim_side_by_sign;
+    double v1 = 0.0;
+    for_chunks(rec.store, rec.vy, 0, std::min(rec.size(), ar.run.ysim.size()),
+               [&](std::size_t base, const auto& cols) {
+                 for (std::size_t k = 0; k < cols[0].size(); ++k) {
+                   ar.run.ysim[base + k] = m.step(v1);
+                   v1 = std::isfinite(cols[0][k]) ? cols[0][k] : 0.0;
+                 }
+               });
+  }
+}
+
+}  // namespace lash
