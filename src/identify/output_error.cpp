@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "lash/identify/auto.hpp"
@@ -52,7 +53,7 @@ bool admissible(const OutputErrorParams& t) noexcept {
          t[6] <= 0.0 && t[3] >= 0.0 && t[7] >= 0.0;
 }
 
-/// One pass: rᵀr at θ and, with `jacobian`, JᵀJ and Jᵀr by forward differences of step h.
+/// One pass: rᵀr, JᵀJ and Jᵀr at θ (J by forward differences of step h).
 struct Pass {
   double sse = 0.0;
   Mat jtj{};
@@ -62,15 +63,21 @@ struct Pass {
   double sse_given = 0.0;  // against y as given
 };
 
-Pass run_pass(const RecordColumns& rec, const OutputErrorParams& th, const OutputErrorParams& h, bool jacobian,
+/// The model at θ and at its P forward-difference points θ + h_i e_i.
+template <std::size_t... I>
+std::array<FreeRunDzDb, P + 1> perturbed(const OutputErrorParams& th, const OutputErrorParams& h, bool by_sign,
+                                         std::index_sequence<I...>) {
+  const auto at = [&](std::size_t i) {
+    OutputErrorParams t = th;
+    if (i > 0) t[i - 1] += h[i - 1];
+    return FreeRunDzDb(t, by_sign);
+  };
+  return {at(I)...};
+}
+
+Pass run_pass(const RecordColumns& rec, const OutputErrorParams& th, const OutputErrorParams& h,
               const OutputErrorOptions& o, std::size_t end) {
-  std::array<FreeRunDzDb, P + 1> m;
-  for (std::size_t i = 0; i <= P; ++i) {
-    m[i].th = th;
-    m[i].by_sign = o.side_by_sign;
-    if (i > 0) m[i].th[i - 1] += h[i - 1];
-  }
-  const std::size_t models = jacobian ? P + 1 : 1;
+  auto m = perturbed(th, h, o.side_by_sign, std::make_index_sequence<P + 1>{});
   Pass p;
   double v1 = 0.0;
   std::size_t next_edit = 0;
@@ -79,7 +86,7 @@ Pass run_pass(const RecordColumns& rec, const OutputErrorParams& th, const Outpu
     const auto& y = cols[1];
     for (std::size_t k = 0; k < v.size(); ++k) {
       std::array<double, P + 1> ys{};
-      for (std::size_t i = 0; i < models; ++i) ys[i] = m[i].step(v1);
+      for (std::size_t i = 0; i <= P; ++i) ys[i] = m[i].step(v1);
       v1 = v[k];
       if (base + k < o.begin || !std::isfinite(y[k]) || !std::isfinite(v[k])) {
         if (!std::isfinite(v1)) v1 = 0.0;  // a missing input drives nothing
@@ -93,7 +100,6 @@ Pass run_pass(const RecordColumns& rec, const OutputErrorParams& th, const Outpu
       p.sse_given += (y[k] - ys[0]) * (y[k] - ys[0]);
       p.y_peak = std::max(p.y_peak, std::fabs(y[k]));
       ++p.n;
-      if (!jacobian) continue;
       OutputErrorParams g;  // ∂y_sim/∂θ
       for (std::size_t i = 0; i < P; ++i) g[i] = (ys[i + 1] - ys[0]) / h[i];
       for (std::size_t i = 0; i < P; ++i) {
@@ -109,17 +115,12 @@ Pass run_pass(const RecordColumns& rec, const OutputErrorParams& th, const Outpu
 
 }  // namespace
 
+FreeRunDzDb::FreeRunDzDb(const OutputErrorParams& th, bool by_sign) noexcept
+    : edge_{th[2], th[6]}, sides_{{th[0], th[1], th[3]}, {th[4], th[5], th[7]}}, by_sign_(by_sign) {}
+
 double FreeRunDzDb::step(double v1) noexcept {
-  const PerSide<double> edge{th[2], th[6]};
-  const Side s = detail::free_run_side(v1, edge, right ? Side::right : Side::left, by_sign);
-  right = s == Side::right;
-  const double u = detail::deadzone(v1, th[6], th[2]);
-  const std::size_t o = right ? 0 : 4;
-  w = -th[o] * w + th[o + 1] * u;
-  const double d = th[o + 3];
-  if (w < y - d) y = w + d;
-  else if (w > y + d) y = w - d;
-  return y;
+  y_ = detail::dzdb_free_run(v1, edge_, sides_, by_sign_, last_, w_, y_);
+  return y_;
 }
 
 OutputErrorFit fit_output_error(const RecordColumns& rec, const OutputErrorParams& start,
@@ -141,7 +142,7 @@ OutputErrorFit fit_output_error(const RecordColumns& rec, const OutputErrorParam
     h[b + 3] = 1e-7 * std::max(std::fabs(start[b + 3]), 1e-3 * cscale);
   }
   OutputErrorParams theta = start;
-  Pass cur = run_pass(rec, theta, h, true, o, end);
+  Pass cur = run_pass(rec, theta, h, o, end);
   f.passes = 1;
   if (!std::isfinite(cur.sse) || cur.n <= P) return f;
   f.rms_start = std::sqrt(cur.sse / static_cast<double>(cur.n));
@@ -162,7 +163,7 @@ OutputErrorFit fit_output_error(const RecordColumns& rec, const OutputErrorParam
       else mu *= 10.0;
     }
     if (!found) break;
-    Pass cand = run_pass(rec, next, h, true, o, end);
+    Pass cand = run_pass(rec, next, h, o, end);
     ++f.passes;
     if (std::isfinite(cand.sse) && cand.sse < cur.sse) {
       const double gain = (cur.sse - cand.sse) / cur.sse;
@@ -209,10 +210,21 @@ OutputErrorFit fit_output_error(const RecordColumns& rec, const OutputErrorParam
 }
 
 namespace {
+/// Where a side's (a1, b1, c, d) sit in θ.
+constexpr std::size_t offset(Side s) noexcept { return s == Side::right ? 0 : 4; }
+void put(OutputErrorParams& th, Side s, const SideParams& p) noexcept {
+  const std::size_t b = offset(s);
+  th[b] = p.a1, th[b + 1] = p.b1, th[b + 2] = p.c, th[b + 3] = p.d;
+}
+void get(const OutputErrorParams& th, Side s, SideParams& p) noexcept {
+  const std::size_t b = offset(s);
+  p.a1 = th[b], p.b1 = th[b + 1], p.c = th[b + 2], p.d = th[b + 3];
+}
+
 /// The 95 % intervals of one side from the fit: ±half95 around a1, b1, c, d; K and τ by the delta
 /// method from the (a1, b1) covariance (K = b1/(1 + a1), τ = −T/ln(−a1)).
-SideIntervals fit_intervals(const OutputErrorFit& f, std::size_t side, double dt_s) {
-  const std::size_t b = 4 * side;
+SideIntervals fit_intervals(const OutputErrorFit& f, Side side, double dt_s) {
+  const std::size_t b = offset(side);
   const auto iv = [](double c, double h) { return std::isfinite(h) ? Interval{c - h, c + h} : Interval{}; };
   SideIntervals ci;
   ci.a1 = iv(f.theta[b], f.half95[b]);
@@ -220,7 +232,7 @@ SideIntervals fit_intervals(const OutputErrorFit& f, std::size_t side, double dt
   ci.c = iv(f.theta[b + 2], f.half95[b + 2]);
   ci.d = iv(f.theta[b + 3], f.half95[b + 3]);
   const double a1 = f.theta[b], b1 = f.theta[b + 1];
-  const auto& [vaa, vab, vbb] = f.ab_cov[side];
+  const auto& [vaa, vab, vbb] = f.ab_cov[b / 4];
   const double ka = -b1 / ((1.0 + a1) * (1.0 + a1)), kb = 1.0 / (1.0 + a1);
   const double var_k = ka * ka * vaa + 2.0 * ka * kb * vab + kb * kb * vbb;
   if (std::isfinite(var_k)) ci.K = iv(static_gain(a1, b1), 1.96 * std::sqrt(std::max(0.0, var_k)));
@@ -266,14 +278,16 @@ void refine_by_output_error(AutoRun& ar, const RecordColumns& rec, std::size_t b
   for (const Side s : {Side::right, Side::left}) {
     const SideParams& p = rep[s].params;
     const SideParams& q = rep[s == Side::right ? Side::left : Side::right].params;
-    const std::size_t b = s == Side::right ? 0 : 4;
     if (p.reason == Reason::not_excited) {
       out.why_not = "a side is not excited (its input held one level or one value)";
       return;
     }
-    if (finite(p)) start[b] = p.a1, start[b + 1] = p.b1, start[b + 2] = p.c, start[b + 3] = p.d;
-    else if (finite(q)) start[b] = q.a1, start[b + 1] = q.b1, start[b + 2] = -q.c, start[b + 3] = q.d;
-    else {
+    if (finite(p)) put(start, s, p);
+    else if (finite(q)) {
+      SideParams mirrored = q;
+      mirrored.c = -q.c;
+      put(start, s, mirrored);
+    } else {
       out.why_not = "neither side has an estimate to start from";
       return;
     }
@@ -302,8 +316,8 @@ void refine_by_output_error(AutoRun& ar, const RecordColumns& rec, std::size_t b
   rep.identified = true;
   for (const Side s : {Side::right, Side::left}) {
     SideReport& r = rep[s];
-    const std::size_t b = s == Side::right ? 0 : 4;
-    r.params.a1 = f.theta[b], r.params.b1 = f.theta[b + 1], r.params.c = f.theta[b + 2], r.params.d = f.theta[b + 3];
+    const std::size_t b = offset(s);
+    get(f.theta, s, r.params);
     r.K = static_gain(r.params.a1, r.params.b1);
     r.tau_s = time_constant_s(r.params.a1, cfg.dt_s);
     {  // checks 3–6 again on the new values; check 2 on the fit's information (JᵀJ)
@@ -321,11 +335,10 @@ void refine_by_output_error(AutoRun& ar, const RecordColumns& rec, std::size_t b
     if (!r.params.identified) rep.identified = false;
   }
   if (intervals)
-    attach_intervals(rep, {fit_intervals(f, 0, cfg.dt_s), fit_intervals(f, 1, cfg.dt_s)}, cfg.ci_tolerance);
+    attach_intervals(rep, {fit_intervals(f, Side::right, cfg.dt_s), fit_intervals(f, Side::left, cfg.dt_s)},
+                     cfg.ci_tolerance);
   if (!ar.run.ysim.empty()) {  // the stored free run: the refined model's
-    FreeRunDzDb m;
-    m.th = f.theta;
-    m.by_sign = cfg.sim_side_by_sign;
+    FreeRunDzDb m(f.theta, cfg.sim_side_by_sign);
     double v1 = 0.0;
     for_chunks(rec.store, rec.vy, 0, std::min(rec.size(), ar.run.ysim.size()),
                [&](std::size_t base, const auto& cols) {

@@ -83,6 +83,24 @@ constexpr Side free_run_side(double x, const PerSide<double>& edge, Side last, b
   if (by_sign) return side_of(x);
   return x > edge.right ? Side::right : (x < edge.left ? Side::left : last);
 }
+/// The free-run model of one side of deadzone → first order → deadband (eq. 36).
+struct DzDbSide {
+  double a1 = 0.0, b1 = 0.0, d = 0.0;
+};
+/// One step of that free run: the side by free_run_side (updates `last`), w ← −a1·w + b1·DZ(v1)
+/// on the linear part's output w, and the output y held within ±d of w (eq. 5–6). Returns the
+/// new y. The estimator's free run (models/deadzone_deadband.cpp) and the output-error fit
+/// (output_error.cpp) step this one function.
+[[gnu::always_inline]] constexpr double dzdb_free_run(double v1, const PerSide<double>& edge,
+                                                     const PerSide<DzDbSide>& sides, bool by_sign, Side& last,
+                                                     double& w, double y) noexcept {
+  last = free_run_side(v1, edge, last, by_sign);
+  const DzDbSide& m = sides[last];
+  w = -m.a1 * w + m.b1 * deadzone(v1, edge.left, edge.right);
+  if (w < y - m.d) return w + m.d;
+  if (w > y + m.d) return w - m.d;
+  return y;
+}
 /// Input-side switching (eq. 18): right when v(k−1) > c_r*, left when v(k−1) < c_l*, none inside.
 constexpr std::optional<Side> guess_side(double v1, const EstimatorConfig& c) noexcept {
   if (v1 > c.guess_right) return Side::right;

@@ -22,6 +22,7 @@
 #include <cstdint>
 #include <span>
 
+#include "lash/identify/estimator_skeleton.hpp"
 #include "lash/identify/record_columns.hpp"
 
 namespace lash {
@@ -59,14 +60,19 @@ struct OutputErrorFit {
 };
 
 /// The model's free run at θ from rest (w = y_sim = 0, the right side first), one sample at a
-/// time: y_sim(k) from v up to k − 1, as the estimators' free run (docs/method.md §A4.2).
-struct FreeRunDzDb {
-  OutputErrorParams th{};
-  bool by_sign = false;
-  double w = 0.0, y = 0.0;
-  bool right = true;
+/// time: y_sim(k) from v up to k − 1, the estimators' free run (detail::dzdb_free_run).
+class FreeRunDzDb {
+ public:
+  FreeRunDzDb(const OutputErrorParams& th, bool by_sign) noexcept;
   /// y_sim(k) given v(k − 1).
   double step(double v1) noexcept;
+
+ private:
+  PerSide<double> edge_{};
+  PerSide<detail::DzDbSide> sides_{};
+  bool by_sign_ = false;
+  Side last_ = Side::right;
+  double w_ = 0.0, y_ = 0.0;
 };
 
 /// Levenberg–Marquardt over the record's columns from `start` (a1 within (−1, 1), b1 > 0,

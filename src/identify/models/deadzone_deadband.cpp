@@ -93,14 +93,7 @@ DeadzoneDeadbandModel::DeadzoneDeadbandModel(const EstimatorConfig& cfg)
 }
 
 [[gnu::always_inline]] inline void DeadzoneDeadbandModel::free_run(EstimatorCore& c) noexcept {
-  const Side s = detail::free_run_side(c.vraw1, sc_, sim_last_, c.cfg.sim_side_by_sign);
-  sim_last_ = s;
-  const double u = detail::deadzone(c.vraw1, sc_.left, sc_.right);
-  const FreeRunSide& m = sim_[s];
-  w_ = -m.a1 * w_ + m.b1 * u;
-  const double d = m.d;
-  if (w_ < c.ysim - d) c.ysim = w_ + d;
-  else if (w_ > c.ysim + d) c.ysim = w_ - d;
+  c.ysim = detail::dzdb_free_run(c.vraw1, sc_, sim_, c.cfg.sim_side_by_sign, sim_last_, w_, c.ysim);
 }
 
 [[gnu::always_inline]] inline double DeadzoneDeadbandModel::update(EstimatorCore& c, const Conditioned& s,

@@ -87,10 +87,7 @@ class DeadzoneDeadbandModel {
   bool pooled_mode_;
   std::array<std::uint64_t, 4> count_{};
   PerSide<bool> usable_{};
-  struct FreeRunSide {  // the free-run model of a side, read together on every sample
-    double a1 = 0.0, b1 = 0.0, d = 0.0;
-  };
-  PerSide<FreeRunSide> sim_{};
+  PerSide<detail::DzDbSide> sim_{};  // the free-run model of each side, read together on every sample
   PerSide<double> sc_{};
   PerSide<double> prev_c_{}, prev_d_{};
   PerSide<std::uint32_t> settled_{};
