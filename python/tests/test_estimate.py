@@ -161,3 +161,15 @@ def test_trace_columns(e2_csv):
     assert refined.params["c_r"].tobytes() == r.params["c_r"].tobytes()
     assert refined.to_dict()["right"]["c"] != r.to_dict()["right"]["c"]
     assert abs(refined.to_dict()["right"]["c"] / 200.0 - 1) < 0.01  # E2's right edge
+
+
+def test_refined_free_run_is_the_reported_one(e2_csv):
+    # the stored y_sim is the refined model's free run: its NRMSE over the window is the one reported
+    d = read_csv(e2_csv)
+    r = lash.estimate(d["t"], d["v"], d["y"], guess_left=-350.0, guess_right=350.0)
+    j = r.to_dict()
+    assert j["output_error"]["used"]
+    t0, t1 = r.nrmse_window_s
+    w = (d["t"] >= t0) & (d["t"] <= t1)
+    e = d["y"][w] - np.asarray(r.ysim)[w]
+    assert abs(np.sqrt(np.mean(e ** 2)) / np.abs(d["y"][w]).max() - j["nrmse"]) <= 1e-12 * j["nrmse"]

@@ -338,7 +338,7 @@ void refine_by_output_error(AutoRun& ar, const RecordColumns& rec, std::size_t b
     attach_intervals(rep, {fit_intervals(f, Side::right, cfg.dt_s), fit_intervals(f, Side::left, cfg.dt_s)},
                      cfg.ci_tolerance);
   if (!ar.run.ysim.empty()) {  // the stored free run: the refined model's
-    FreeRunDzDb m(f.theta, cfg.sim_side_by_sign);
+    FreeRunDzDb m(f.theta, o.side_by_sign);  // the rule the fit used
     double v1 = 0.0;
     for_chunks(rec.store, rec.vy, 0, std::min(rec.size(), ar.run.ysim.size()),
                [&](std::size_t base, const auto& cols) {
