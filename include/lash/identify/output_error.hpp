@@ -3,7 +3,8 @@
 /// Output-error refinement of a deadzone-deadband estimate over a whole record (docs/method.md
 /// §A4.8): the eight parameters θ = (a1, b1, c, d) of each side are moved to minimise the sum
 /// of squares of y − y_sim(θ), the free run of the model driven by v alone (the verdict's
-/// simulation, eq. 36 of the thesis with the free-run side rule of §A4.2), by Levenberg–Marquardt
+/// simulation, eq. 36 of the thesis; the refinement takes the side of the sign of v(k−1), eq. 34,
+/// the rule of lash's plant blocks/deadband.hpp), by Levenberg–Marquardt
 /// from the switching estimate. Why: the switching RLS regresses y(k) on the measured y(k−1);
 /// with measurement noise that regressor is noisy (errors in variables), its instruments are
 /// weak where the pole is near 1 (b1 = K(1 + a1): a1 off by 3·10⁻⁴ moves b1 by 3 % at
@@ -96,13 +97,14 @@ struct EstimatorConfig;
 void refuse_output_error_online(const EstimatorConfig& cfg, const char* where);
 
 /// With cfg.output_error on a deadzone-deadband run: fits rows [begin, end) of `record` from the
-/// run's estimate and, when the fit is ok, puts its parameters (and K, τ) in the report, the free
-/// run's NRMSE over those rows in the report's fit and the run's score, and judges the sides whose
-/// verdict was about the estimate (identified, uncertain or poor_fit: checks 3–6 again on the new
-/// values); sides refused for their input (not_updated, not_excited, ...) keep their reason. With
-/// `intervals`, the fit's 95 % intervals replace the batch means' and checks 7–8 run on them.
-/// Not used (why_not says why): a dead time, a side without finite parameters, a start the free
-/// run cannot hold, or a fit that failed.
+/// run's estimate (a side without one starts from the other side's, its edge mirrored) and, when
+/// the fit is ok, puts its parameters (and K, τ) in the report, the free run's NRMSE over those
+/// rows in the report's fit and the run's score, the refined free run in the stored y_sim, and
+/// judges both sides again: checks 3–6 on the new values, check 2 on the fit's information (a
+/// side whose JᵀJ block is singular is not_excited). With `intervals`, the fit's 95 % intervals
+/// replace the batch means' and checks 7–8 run on them. Not used (why_not says why): a dead
+/// time, a side not_excited by the switching run's checks (its input held one level or one
+/// value), no side with finite parameters, a start the free run cannot hold, or a failed fit.
 /// `gate`: the outlier gate's threshold of the run (AutoOptions::gate; 0 = off): the fit reads y
 /// with the gate's replacements, the NRMSE is taken against y as given.
 void refine_by_output_error(AutoRun& run, const RecordColumns& record, std::size_t begin, std::size_t end,
