@@ -144,7 +144,8 @@ def estimate_run(lash, kind, seed, rec, p, sigma):
             ci = j[side]["ci95"].get(k) if j[side]["identified"] else None
             cover[f"{k}_{side[0]}"] = None if ci is None else bool(ci[0] <= want <= ci[1])
     return dict(kind=kind, seed=seed, identified=ident, errs=errs, plant=p, sigma=sigma,
-                switching=j.get("model_switching"), cover=cover,
+                switching=j.get("model_switching"), cover=cover, output_error=j.get("output_error"),
+                reasons={s: j[s]["reason"] for s in ("right", "left")},
                 sides_identified=sum(bool(j[s]["identified"]) for s in ("right", "left")))
 
 

@@ -47,6 +47,13 @@ std::string sig(double x) { return std::isfinite(x) ? fmt::format("{:.6g}", x) :
 std::string sig(const Interval& iv) {
   return iv.valid() ? fmt::format("[{}, {}]", sig(iv.lo), sig(iv.hi)) : std::string("-");
 }
+
+/// Whether some side (linear: the model) has an estimate. Without one the free run ran on the
+/// recursion's unsettled values (an unstable a1 gave NRMSEs of 1e69 %): no fit to report.
+bool has_estimate(const EstimateReport& r) {
+  const auto est = [](const SideReport& s) { return std::isfinite(s.params.a1) && std::isfinite(s.params.b1); };
+  return est(r.right) || (r.model != ModelKind::linear && est(r.left));
+}
 }  // namespace
 
 std::string estimate_json(const EstimateReport& r, const ReportFit& fit) {
@@ -65,8 +72,9 @@ std::string estimate_json(const EstimateReport& r, const ReportFit& fit) {
     j["d_reason"] = reason(r.d_reason);
     j["d_ci95"] = interval(r.right.ci95.d);
   }
-  j["nrmse"] = num(fit.nrmse);
-  j["nrmse_pct"] = num(100.0 * fit.nrmse);
+  const double nrmse = has_estimate(r) ? fit.nrmse : std::nan("");
+  j["nrmse"] = num(nrmse);
+  j["nrmse_pct"] = num(100.0 * nrmse);
   j["nrmse_window_s"] = {fit.t0_s, fit.t1_s};
   j["rows_skipped"] = fit.rows_skipped;
   j["samples_skipped"] = r.skipped;  // the text's "N skipped"
@@ -111,8 +119,8 @@ std::string estimate_text(const EstimateReport& r, double dt_s, const ReportFit&
     out += fmt::format("     d = {} (updates +:{} -:{}){}{}\n", sig(r.d), r.d_updates[0].second, r.d_updates[1].second,
                        r.d_reason == Reason::none ? "" : fmt::format("  NOT identified ({})", to_string(r.d_reason)),
                        r.right.ci95.d.valid() ? "  95 %: " + sig(r.right.ci95.d) : "");
-  out += fmt::format("NRMSE of the simulated output over [{}, {}] s: {} %\n", sig(fit.t0_s), sig(fit.t1_s),
-                     sig(100.0 * fit.nrmse));
+  out += fmt::format("NRMSE of the simulated output over [{}, {}] s: {}\n", sig(fit.t0_s), sig(fit.t1_s),
+                     has_estimate(r) ? sig(100.0 * fit.nrmse) + " %" : "- (no side has an estimate to simulate)");
   return out;
 }
 

@@ -1,4 +1,4 @@
-// Output-error refinement (include/lash/identify/output_error.hpp, docs/method.md §A4.8).
+// Output-error refinement (include/lash/identify/output_error.hpp, docs/method.md §A4.4c).
 // The record comes from lash's plant blocks (deadzone -> first-order lag -> deadband, the side of
 // the deadband by the sign of v(k-1)), an implementation independent of the fit's free run.
 // Checked: the free run of the plant's parameters is the plant (to rounding); from a start 3-10 %

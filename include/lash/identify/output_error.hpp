@@ -1,7 +1,7 @@
 #pragma once
 /// @file output_error.hpp
 /// Output-error refinement of a deadzone-deadband estimate over a whole record (docs/method.md
-/// §A4.8): the eight parameters θ = (a1, b1, c, d) of each side are moved to minimise the sum
+/// §A4.4c): the eight parameters θ = (a1, b1, c, d) of each side are moved to minimise the sum
 /// of squares of y − y_sim(θ), the free run of the model driven by v alone (the verdict's
 /// simulation, eq. 36 of the thesis; the refinement takes the side of the sign of v(k−1), eq. 34,
 /// the rule of lash's plant blocks/deadband.hpp), by Levenberg–Marquardt

@@ -48,7 +48,7 @@ void DeadzoneDeadbandModel::tune(EstimatorConfig& c, const DataTraits& d) {
   const double noise = 3.0 * d.noise_sigma * std::sqrt(h2);
   const double quant = d.quantum > 0.0 ? d.quantum / (m2 * c.dt_s) : 0.0;
   c.noise.derivative_threshold = std::max({noise, quant, kRateShare * d.ydot_p90});
-  // a whole record: the switching estimate is refined by output error (docs/method.md §A4.8)
+  // a whole record: the switching estimate is refined by output error (docs/method.md §A4.4c)
   c.output_error = true;
 }
 
