@@ -312,7 +312,9 @@ std::string estimate_auto_json(const AutoRun& ar, Preset preset, const ReportFit
                 {"steps", oe.fit.steps},
                 {"residuals", oe.fit.n},
                 {"rms_start", num(oe.fit.rms_start)},
-                {"rms", num(oe.fit.rms)}});
+                {"rms", num(oe.fit.rms)},
+                {"residual_rho1", num(oe.fit.rho1)},
+                {"variance_factor", num(oe.fit.variance_factor)}});
     else
       o["why_not"] = oe.why_not;
     j["output_error"] = o;

@@ -61,6 +61,7 @@ struct Pass {
   std::size_t n = 0;
   double y_peak = 0.0;
   double sse_given = 0.0;  // against y as given
+  double lag1 = 0.0;       // Σ r(k)·r(k−1) over consecutive summed rows
 };
 
 /// The model at θ and at its P forward-difference points θ + h_i e_i.
@@ -79,7 +80,8 @@ Pass run_pass(const RecordColumns& rec, const OutputErrorParams& th, const Outpu
               const OutputErrorOptions& o, std::size_t end) {
   auto m = perturbed(th, h, o.side_by_sign, std::make_index_sequence<P + 1>{});
   Pass p;
-  double v1 = 0.0;
+  double v1 = 0.0, r_prev = 0.0;
+  bool have_prev = false;
   std::size_t next_edit = 0;
   for_chunks(rec.store, rec.vy, 0, end, [&](std::size_t base, const auto& cols) {
     const auto& v = cols[0];
@@ -90,6 +92,7 @@ Pass run_pass(const RecordColumns& rec, const OutputErrorParams& th, const Outpu
       v1 = v[k];
       if (base + k < o.begin || !std::isfinite(y[k]) || !std::isfinite(v[k])) {
         if (!std::isfinite(v1)) v1 = 0.0;  // a missing input drives nothing
+        have_prev = false;
         continue;
       }
       double yk = y[k];
@@ -97,6 +100,9 @@ Pass run_pass(const RecordColumns& rec, const OutputErrorParams& th, const Outpu
       if (next_edit < o.edit_rows.size() && o.edit_rows[next_edit] == base + k) yk = o.edit_values[next_edit];
       const double r = yk - ys[0];
       p.sse += r * r;
+      if (have_prev) p.lag1 += r * r_prev;
+      r_prev = r;
+      have_prev = true;
       p.sse_given += (y[k] - ys[0]) * (y[k] - ys[0]);
       p.y_peak = std::max(p.y_peak, std::fabs(y[k]));
       ++p.n;
@@ -189,8 +195,14 @@ OutputErrorFit fit_output_error(const RecordColumns& rec, const OutputErrorParam
   f.rms = std::sqrt(cur.sse / static_cast<double>(cur.n));
   f.y_peak = cur.y_peak;
   f.rms_given = std::sqrt(cur.sse_given / static_cast<double>(cur.n));
-  // covariance σ̂²(JᵀJ)⁻¹ at the result
-  const double s2 = cur.sse / static_cast<double>(cur.n - P);
+  // covariance σ̂²(JᵀJ)⁻¹ at the result, σ̂² widened by the residual's long-run variance factor
+  // (1 + ρ1)/(1 − ρ1) when its lag-1 autocorrelation ρ1 is positive: the residual of a model
+  // that does not fit (unmodelled dynamics, coloured noise, a local minimum) is correlated, and
+  // J's columns, sensitivities of a low-pass free run, are slow, so Jᵀr sums about n(1 − ρ1)/(1 + ρ1)
+  // independent terms (an AR(1) residual's effective sample size)
+  f.rho1 = cur.sse > 0.0 ? std::clamp(cur.lag1 / cur.sse, -1.0, 0.999) : 0.0;
+  f.variance_factor = std::max(1.0, (1.0 + f.rho1) / (1.0 - f.rho1));
+  const double s2 = f.variance_factor * cur.sse / static_cast<double>(cur.n - P);
   Mat inv{};
   bool regular = true;
   for (std::size_t j = 0; j < P && regular; ++j) {

@@ -53,7 +53,14 @@ struct OutputErrorFit {
   double rms_given = 0.0;      ///< at the result, against y as given (no edits) [y unit]
   double y_peak = 0.0;         ///< max |y| (as given) over the residuals' rows (the NRMSE's scale) [y unit]
   OutputErrorParams theta{};   ///< the result (the start when !ok)
-  /// 95 % half-widths of θ: 1.96·√diag(σ̂²(JᵀJ)⁻¹), σ̂² = rᵀr/(n − 8); NaN where JᵀJ is singular.
+  /// Lag-1 autocorrelation of the residual y − y_sim at the result, Σ r(k)r(k−1) / Σ r(k)²
+  /// (at most 0.999): about 0 for white measurement noise.
+  double rho1 = 0.0;
+  /// σ̂²'s factor max(1, (1 + ρ1)/(1 − ρ1)): a correlated residual (a model that does not fit)
+  /// holds fewer independent errors than rows (docs/method.md §A4.4c).
+  double variance_factor = 1.0;
+  /// 95 % half-widths of θ: 1.96·√diag(σ̂²(JᵀJ)⁻¹), σ̂² = variance_factor·rᵀr/(n − 8); NaN where
+  /// JᵀJ is singular.
   OutputErrorParams half95{};
   /// The covariance σ̂²(JᵀJ)⁻¹ of (a1, b1) per side ({var a1, cov, var b1}; right, left): the
   /// intervals of K = b1/(1 + a1) and τ by the delta method.
