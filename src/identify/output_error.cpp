@@ -108,6 +108,7 @@ Pass run_pass(const RecordColumns& rec, const OutputErrorParams& th, const Outpu
       ++p.n;
       OutputErrorParams g;  // ∂y_sim/∂θ
       for (std::size_t i = 0; i < P; ++i) g[i] = (ys[i + 1] - ys[0]) / h[i];
+      if (!o.fit_d) g[3] = g[7] = 0.0;  // d held: no column
       for (std::size_t i = 0; i < P; ++i) {
         p.jtr[i] += g[i] * r;
         for (std::size_t j = 0; j <= i; ++j) p.jtj[i][j] += g[i] * g[j];
@@ -116,6 +117,7 @@ Pass run_pass(const RecordColumns& rec, const OutputErrorParams& th, const Outpu
   });
   for (std::size_t i = 0; i < P; ++i)
     for (std::size_t j = i + 1; j < P; ++j) p.jtj[i][j] = p.jtj[j][i];
+  if (!o.fit_d) p.jtj[3][3] = p.jtj[7][7] = 1.0;  // a held parameter: its step solves to 0
   return p;
 }
 
@@ -202,7 +204,8 @@ OutputErrorFit fit_output_error(const RecordColumns& rec, const OutputErrorParam
   // independent terms (an AR(1) residual's effective sample size)
   f.rho1 = cur.sse > 0.0 ? std::clamp(cur.lag1 / cur.sse, -1.0, 0.999) : 0.0;
   f.variance_factor = std::max(1.0, (1.0 + f.rho1) / (1.0 - f.rho1));
-  const double s2 = f.variance_factor * cur.sse / static_cast<double>(cur.n - P);
+  const std::size_t free = o.fit_d ? P : P - 2;
+  const double s2 = f.variance_factor * cur.sse / static_cast<double>(cur.n - free);
   Mat inv{};
   bool regular = true;
   for (std::size_t j = 0; j < P && regular; ++j) {
@@ -213,6 +216,7 @@ OutputErrorFit fit_output_error(const RecordColumns& rec, const OutputErrorParam
   }
   if (regular) {
     for (std::size_t i = 0; i < P; ++i) f.half95[i] = 1.96 * std::sqrt(std::max(0.0, s2 * inv[i][i]));
+    if (!o.fit_d) f.half95[3] = f.half95[7] = kNaN;
     for (std::size_t s = 0; s < 2; ++s) {
       const std::size_t b = 4 * s;
       f.ab_cov[s] = {s2 * inv[b][b], s2 * inv[b][b + 1], s2 * inv[b + 1][b + 1]};
@@ -272,7 +276,9 @@ void refine_by_output_error(AutoRun& ar, const RecordColumns& rec, std::size_t b
   OutputErrorReport& out = ar.output_error;
   out = {};
   const EstimatorConfig& cfg = ar.cfg;
-  if (!cfg.output_error || cfg.model != ModelKind::deadzone_deadband) return;
+  if (!cfg.output_error || (cfg.model != ModelKind::deadzone_deadband && cfg.model != ModelKind::input_deadzone))
+    return;
+  const bool has_d = cfg.model == ModelKind::deadzone_deadband;  // input-deadzone: d = 0 held
   out.tried = true;
   if (cfg.noise.dead_time != 0) {
     out.why_not = "the model has a dead time (the free run of the refinement has none)";
@@ -283,8 +289,8 @@ void refine_by_output_error(AutoRun& ar, const RecordColumns& rec, std::size_t b
   // failed) starts from the other side's dynamics and deadband with its edge mirrored (the free
   // run needs every parameter). A side not excited (its input held one level or one value) is
   // not refined: its parameters are not told apart by the record.
-  const auto finite = [](const SideParams& p) {
-    return std::isfinite(p.a1) && std::isfinite(p.b1) && std::isfinite(p.c) && std::isfinite(p.d);
+  const auto finite = [has_d](const SideParams& p) {
+    return std::isfinite(p.a1) && std::isfinite(p.b1) && std::isfinite(p.c) && (!has_d || std::isfinite(p.d));
   };
   OutputErrorParams start{};
   for (const Side s : {Side::right, Side::left}) {
@@ -313,6 +319,8 @@ void refine_by_output_error(AutoRun& ar, const RecordColumns& rec, std::size_t b
   o.edit_rows = edit_rows;
   o.edit_values = edit_values;
   o.side_by_sign = true;  // the plant's structure (eq. 34, blocks/deadband.hpp): the side of the sign of v(k−1)
+  o.fit_d = has_d;
+  if (!has_d) start[3] = start[7] = 0.0;
   out.fit = fit_output_error(rec, start, o);
   const OutputErrorFit& f = out.fit;
   if (!f.ok) {
@@ -329,7 +337,9 @@ void refine_by_output_error(AutoRun& ar, const RecordColumns& rec, std::size_t b
   for (const Side s : {Side::right, Side::left}) {
     SideReport& r = rep[s];
     const std::size_t b = offset(s);
+    const double d_before = r.params.d;
     get(f.theta, s, r.params);
+    if (!has_d) r.params.d = d_before;  // not a parameter of the model
     r.K = static_gain(r.params.a1, r.params.b1);
     r.tau_s = time_constant_s(r.params.a1, cfg.dt_s);
     {  // checks 3–6 again on the new values; check 2 on the fit's information (JᵀJ)
@@ -337,9 +347,10 @@ void refine_by_output_error(AutoRun& ar, const RecordColumns& rec, std::size_t b
       e.side = s;
       e.updated = true;
       e.excited = std::isfinite(f.half95[b]) && std::isfinite(f.half95[b + 1]) && std::isfinite(f.half95[b + 2]) &&
-                  std::isfinite(f.half95[b + 3]);
+                  (!has_d || std::isfinite(f.half95[b + 3]));
       e.a1 = r.params.a1, e.b1 = r.params.b1, e.c = r.params.c, e.d = r.params.d;
-      e.has_c = e.has_d = true;
+      e.has_c = true;
+      e.has_d = has_d;
       r.params.reason = verdict_rules::finish(verdict_rules::judge(e), true, rep.fit_nrmse, cfg.fit_threshold);
       r.params.identified = r.params.reason == Reason::none;
     }

@@ -84,11 +84,19 @@ std::string event_line(const Event& e) {
   return s + "}";
 }
 
+/// The monitor's estimator settings: its periods follow a drift (no whole-window output-error
+/// refinement unless asked, SettingsSources::follows_drift).
+SettingsSources following(SettingsSources s) {
+  s.follows_drift = true;
+  return s;
+}
+
 /// The pipeline's state between frames.
 class Pipeline {
  public:
-  Pipeline(const MonitorSettings& s, SignalMap map) : s_(s), map_(std::move(map)), detector_(s.alarms) {
-    if (s.mode == EstimateMode::online) online_.emplace(s.estimator, s.online);
+  Pipeline(const MonitorSettings& s, SignalMap map)
+      : s_(s), est_(following(s.estimator)), map_(std::move(map)), detector_(s.alarms) {
+    if (s.mode == EstimateMode::online) online_.emplace(est_, s.online);
     if (!s.record_csv.empty()) {
       record_.open(s.record_csv, std::ios::out | std::ios::trunc);
       if (!record_) throw InputError(s.record_csv, 0, "--record", "cannot write the file");
@@ -317,7 +325,7 @@ class Pipeline {
       ArrayEstimateOptions eo;
       eo.sampling = &smp;
       try {
-        const ArrayEstimate e = estimate_arrays(s_.estimator, tt, vv, yy, eo);
+        const ArrayEstimate e = estimate_arrays(est_, tt, vv, yy, eo);
         p.json = e.json;
         p.params = monitored_params(e.run.run.report);
       } catch (const InputError&) {
@@ -364,6 +372,7 @@ class Pipeline {
   }
 
   const MonitorSettings& s_;
+  SettingsSources est_;  ///< s_.estimator, following a drift
   SignalMap map_;
   EventDetector detector_;
   MonitorCounts counts_;
@@ -407,9 +416,9 @@ void check_settings(const MonitorSettings& s) {
   } catch (const std::invalid_argument& e) {
     throw InputError("", 0, "reguess", e.what());
   }
-  (void)resolve_settings(s.estimator);  // the estimator's settings (a bad key or value fails here)
+  (void)resolve_settings(following(s.estimator));  // the estimator's settings (a bad key or value fails here)
   // what the online estimator refuses (model switching), refused before the source opens
-  if (s.mode == EstimateMode::online) (void)OnlineEstimator(s.estimator, s.online);
+  if (s.mode == EstimateMode::online) (void)OnlineEstimator(following(s.estimator), s.online);
   (void)make_map(s);
 }
 

@@ -27,6 +27,10 @@ struct SettingsSources {
   std::vector<std::pair<std::string, std::string>> options;
   std::optional<std::vector<std::string>> columns;           ///< names or 0-based indices of t, v, y
   std::optional<std::pair<double, double>> nrmse_window_s;   ///< NRMSE window [t0, t1] [s]
+  /// The estimates follow a drift (lash monitor's periods): the output-error refinement, which fits
+  /// one constant model to the whole window and so averages a drift in it, stays off unless the
+  /// config file, the keys or an option turn it on (docs/monitor.md).
+  bool follows_drift = false;
 };
 
 struct EstimateSettings {

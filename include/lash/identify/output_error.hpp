@@ -1,6 +1,6 @@
 #pragma once
 /// @file output_error.hpp
-/// Output-error refinement of a deadzone-deadband estimate over a whole record (docs/method.md
+/// Output-error refinement of a deadzone-deadband or input-deadzone estimate over a whole record (docs/method.md
 /// §A4.4c): the eight parameters θ = (a1, b1, c, d) of each side are moved to minimise the sum
 /// of squares of y − y_sim(θ), the free run of the model driven by v alone (the verdict's
 /// simulation, eq. 36 of the thesis; the refinement takes the side of the sign of v(k−1), eq. 34,
@@ -36,6 +36,9 @@ struct OutputErrorOptions {
   std::size_t end = 0;         ///< one past the last (0: the record's end)
   int max_passes = 40;         ///< passes over the record at most
   bool side_by_sign = false;   ///< the free run's side by the sign of v (EstimatorConfig::sim_side_by_sign)
+  /// false: d_r, d_l stay at their start values (input-deadzone: 0, the model has no deadband);
+  /// only a1, b1, c of each side are fitted and their half-widths of d are NaN.
+  bool fit_d = true;
   /// Rows (ascending) whose y the fit reads from `edit_values` instead (the outlier gate's
   /// replacements, gate_outliers): an outlier would pull a least-squares fit.
   std::span<const std::size_t> edit_rows;
@@ -103,7 +106,7 @@ struct EstimatorConfig;
 /// InputError naming `output-error` when it is on (`where`: what the user should use instead).
 void refuse_output_error_online(const EstimatorConfig& cfg, const char* where);
 
-/// With cfg.output_error on a deadzone-deadband run: fits rows [begin, end) of `record` from the
+/// With cfg.output_error on a deadzone-deadband or input-deadzone run (the latter: d = 0 held): fits rows [begin, end) of `record` from the
 /// run's estimate (a side without one starts from the other side's, its edge mirrored) and, when
 /// the fit is ok, puts its parameters (and K, τ) in the report, the free run's NRMSE over those
 /// rows in the report's fit and the run's score, the refined free run in the stored y_sim, and

@@ -25,6 +25,8 @@ void InputDeadzoneModel::tune(EstimatorConfig& c, const DataTraits& d) {
     c.rls.lower = {-1.0, 1e-4 * B, -E};
     c.rls.upper = {0.0, B, E};
   }
+  // a whole record: the switching estimate is refined by output error (docs/method.md §A4.4c)
+  c.output_error = true;
 }
 
 double InputDeadzoneModel::update(EstimatorCore& c, const Conditioned& s, bool) noexcept {
