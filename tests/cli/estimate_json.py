@@ -71,9 +71,17 @@ with tempfile.TemporaryDirectory() as d:
     j = json.loads(out)
     check(in_order(j, ["model", "samples", "a1", "b1", "identified", "updates", "reason", "K", "tau_s", "ci95",
                              "nrmse", "nrmse_pct", "nrmse_window_s"]), f"linear keys {list(j)}")
-    # input-deadzone: no d; a side never excited is null + identified false
-    out = subprocess.run([LASH, "estimate", "--model", "input-deadzone", "--guess-left", "-700",
-                          "--guess-right", "350", data, "--json"], check=True, capture_output=True, text=True).stdout
+    # input-deadzone: no d; a side never excited is null + identified false (the recursion's
+    # outcome: the output-error fit off)
+    one_sided = [LASH, "estimate", "--model", "input-deadzone", "--guess-left", "-700", "--guess-right", "350", data]
+    jd = json.loads(subprocess.run(one_sided + ["--json"], check=True, capture_output=True, text=True).stdout)
+    # by default the fit starts that side from the other one mirrored and fits it from the free run
+    # (docs/method.md §A4.4c): the left edge within 1 % of the plant's -300, the updates still the
+    # recursion's (none)
+    check(jd["output_error"]["used"] and jd["left"]["updates"]["all"] == 0 and jd["left"]["c"] is not None
+          and abs(jd["left"]["c"] / -300.0 - 1) < 0.01, f"default: the fit's left side {jd['left']}")
+    out = subprocess.run(one_sided + ["--output-error=false", "--json"], check=True, capture_output=True,
+                         text=True).stdout
     j = json.loads(out)
     check("d" not in j["right"] and "c" in j["right"], "input-deadzone has c, no d")
     check(j["left"]["identified"] is False and j["left"]["c"] is None and j["left"]["a1"] is None,
@@ -82,8 +90,7 @@ with tempfile.TemporaryDirectory() as d:
     # --plot of that run: the never-identified side is a panel saying so, not a gnuplot failure;
     # the result is printed whatever the plot does
     png = os.path.join(d, "one-sided.png")
-    r = subprocess.run([LASH, "estimate", "--model", "input-deadzone", "--guess-left", "-700", "--guess-right", "350",
-                        data, "--json", "--plot", png], capture_output=True, text=True)
+    r = subprocess.run(one_sided + ["--output-error=false", "--json", "--plot", png], capture_output=True, text=True)
     check(r.returncode == 0 and os.path.getsize(png) > 10000 and json.loads(r.stdout)["left"]["identified"] is False,
           f"--plot with a side never identified: exit {r.returncode}, {r.stderr.strip()[:200]}")
     check(not [n for n in os.listdir(d) if ".tmp." in n], f"no temporary left: {os.listdir(d)}")

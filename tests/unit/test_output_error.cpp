@@ -168,6 +168,33 @@ TEST(OutputError, ACorrelatedResidualWidensTheIntervals) {
   EXPECT_GE(c.inside, static_cast<int>(0.85 * c.intervals)) << c.inside << " of " << c.intervals;
 }
 
+TEST(OutputError, WithDHeldTheInputDeadzonePlantIsFittedOnItsSixParameters) {
+  // the plant without its deadband (lash's deadzone and first-order blocks): input-deadzone's
+  // model; fit_d = false holds d_r = d_l = 0 and fits a1, b1, c of each side
+  const auto v = multisine();
+  Deadzone dz({kTruth[6], kTruth[2]});
+  FirstOrder g(PerSide<FirstOrderParams>::both({kTruth[0], kTruth[1]}));
+  std::vector<double> y(v.size());
+  for (std::size_t k = 0; k < v.size(); ++k) y[k] = g.step(dz.step(v[k]));
+  OutputErrorParams start = kTruth;
+  start[3] = start[7] = 0.0;
+  const double off[8] = {1.003, 1.10, 0.95, 1.0, 1.002, 0.92, 1.06, 1.0};
+  for (std::size_t i = 0; i < 8; ++i) start[i] *= off[i];
+  OutputErrorOptions o = by_sign();
+  o.fit_d = false;
+  const OutputErrorFit f = fit_output_error(RecordColumns::of(v, y), start, o);
+  ASSERT_TRUE(f.ok);
+  EXPECT_TRUE(f.converged);
+  EXPECT_LT(f.rms, 1e-6);
+  for (std::size_t i : {0u, 1u, 2u, 4u, 5u, 6u}) {
+    EXPECT_NEAR(f.theta[i], kTruth[i], 1e-6 * std::fabs(kTruth[i])) << "theta " << i;
+    EXPECT_TRUE(std::isfinite(f.half95[i])) << "theta " << i;
+  }
+  EXPECT_EQ(f.theta[3], 0.0);
+  EXPECT_EQ(f.theta[7], 0.0);
+  EXPECT_TRUE(std::isnan(f.half95[3]) && std::isnan(f.half95[7]));
+}
+
 TEST(OutputError, EditedRowsAreReadInsteadOfTheRecordsY) {
   const auto v = multisine();
   const auto y = plant_output(v);
