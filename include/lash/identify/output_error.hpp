@@ -1,8 +1,8 @@
 #pragma once
 /// @file output_error.hpp
-/// Output-error refinement of a deadzone-deadband or input-deadzone estimate over a whole record (docs/method.md
-/// §A4.4c): the eight parameters θ = (a1, b1, c, d) of each side are moved to minimise the sum
-/// of squares of y − y_sim(θ), the free run of the model driven by v alone (the verdict's
+/// Output-error refinement of a deadzone-deadband or input-deadzone estimate over a whole record
+/// (docs/method.md §A4.4c): the parameters θ = (a1, b1, c, d) of each side (input-deadzone: d = 0
+/// held) are moved to minimise the sum of squares of y − y_sim(θ), the free run of the model driven by v alone (the verdict's
 /// simulation, eq. 36 of the thesis; the refinement takes the side of the sign of v(k−1), eq. 34,
 /// the rule of lash's plant blocks/deadband.hpp), by Levenberg–Marquardt
 /// from the switching estimate. Why: the switching RLS regresses y(k) on the measured y(k−1);
@@ -106,9 +106,9 @@ struct EstimatorConfig;
 /// InputError naming `output-error` when it is on (`where`: what the user should use instead).
 void refuse_output_error_online(const EstimatorConfig& cfg, const char* where);
 
-/// With cfg.output_error on a deadzone-deadband or input-deadzone run (the latter: d = 0 held): fits rows [begin, end) of `record` from the
-/// run's estimate (a side without one starts from the other side's, its edge mirrored) and, when
-/// the fit is ok, puts its parameters (and K, τ) in the report, the free run's NRMSE over those
+/// With cfg.output_error on a deadzone-deadband or input-deadzone run (the latter: d = 0 held):
+/// fits rows [begin, end) of `record` from the run's estimate (a side without one starts from the
+/// other side's, its edge mirrored) and, when the fit is ok, puts its parameters (and K, τ) in the report, the free run's NRMSE over those
 /// rows in the report's fit and the run's score, the refined free run in the stored y_sim, and
 /// judges both sides again: checks 3–6 on the new values, check 2 on the fit's information (a
 /// side whose JᵀJ block is singular is not_excited). With `intervals`, the fit's 95 % intervals
