@@ -159,6 +159,12 @@ def estimate_run(lash, kind, seed, rec, p, sigma, model="deadzone-deadband"):
                 sides_identified=sum(bool(j[s]["identified"]) for s in ("right", "left")))
 
 
+def within_bounds(r):
+    """identified, and every parameter the model has (input-deadzone: no d) within TOL"""
+    tol = {k: t for k, t in TOL.items() if f"{k}_r" in r["errs"]}
+    return r["identified"] and all(r["errs"][f"{k}_{s}"] <= tol[k] for k in tol for s in "rl")
+
+
 def main():
     lash = sys.argv[1]
     arg = sys.argv[2] if len(sys.argv) > 2 else "20"  # N (seeds 1..N) or A-B
@@ -170,9 +176,8 @@ def main():
         for kind in kinds:
             for seed in range(lo, hi + 1):
                 r = run_one(lash, kind, seed, d, model=model)
-                tol = {k: t for k, t in TOL.items() if f"{k}_r" in r["errs"]}
-                ok = r["identified"] and all(r["errs"][f"{k}_{s}"] <= tol[k] for k in tol for s in "rl")
-                worst = {k: max(r["errs"][f"{k}_r"], r["errs"][f"{k}_l"]) for k in tol}
+                ok = within_bounds(r)
+                worst = {k: max(r["errs"][f"{k}_r"], r["errs"][f"{k}_l"]) for k in TOL if f"{k}_r" in r["errs"]}
                 print(f"{kind:9s} seed {seed:2d} {'ok  ' if ok else 'FAIL'} identified {r['identified']} " +
                       " ".join(f"{k} {100 * w:.2f}%" for k, w in worst.items()) +
                       f" passes {r['switching'] and r['switching']['passes']}", flush=True)

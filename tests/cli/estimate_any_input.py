@@ -14,7 +14,7 @@ import json, os, subprocess, sys, tempfile
 
 SRC = os.environ["LASH_SOURCE_DIR"]
 sys.path.insert(0, os.path.join(SRC, "scripts"))
-from any_input_measure import TOL, run_one  # noqa: E402
+from any_input_measure import TOL, run_one, within_bounds  # noqa: E402
 
 LASH = os.environ["LASH"]
 fail = 0
@@ -60,8 +60,7 @@ def measure(model, floors, why, covered):
                     if inside is not None:
                         covered[key.split("_")[0]][0] += inside
                         covered[key.split("_")[0]][1] += 1
-                tol = {k: t for k, t in TOL.items() if f"{k}_r" in r["errs"]}
-                ok = r["identified"] and all(r["errs"][f"{k}_{s}"] <= tol[k] for k in tol for s in "rl")
+                ok = within_bounds(r)
                 good += ok
                 if not ok:  # outside the bounds: never identified
                     check(not r["identified"] and (why is None or any(x in why for x in r["reasons"].values())),
