@@ -4,9 +4,11 @@ longer runs and what they found: docs/identification.md, "The verdict as a prope
 Random plants, inputs (multisine, random steps, PRBS, sine, chirp) and accepted settings, noise-free,
 simulated by the script's own numpy plant. What always holds is asserted as such: settings lash
 cannot run are refused naming the setting, and a1 >= 0 is never identified. The property itself
-(every identified side within 1 % of the truth) does NOT hold yet: a few per cent of the identified
-sides are biased while their intervals are tight. The counts here are the measured ones for these
-seeds; the test fails when a change makes them worse, and prints every violation."""
+(every identified side within 1 % of the truth) holds with lash's defaults on these cases; with
+random settings it does NOT hold under --preset thesis (the thesis's switching and verdict, no
+output-error refinement), whose biased sides have tight intervals. The counts here are the
+measured ones for these seeds; the test fails when a change makes them worse, and prints every
+violation."""
 import os
 import sys
 
@@ -63,10 +65,11 @@ def test_defaults():
     out, refused, violations = run(300, 3, True)
     print(out)
     assert out["refused"] == 0
-    # measured: 2 of 300 runs with a side off by more than 1 % (lash's defaults: two sines that pass
-    # one edge by 7 % or never reach it; the output-error fit's local minimum); 5 before the
-    # refinement (docs/method.md §A4.4c), 7 before model switching checked the dy/dt switching
-    assert out["violation"] <= 2
+    # measured: 0 of 300 runs with a side off by more than 1 %; 2 before the output-error fit's
+    # further starts (two sines that pass one edge by 7 % or never reach it, where the first fit
+    # stops in a local minimum: docs/method.md §A4.4c), 5 before the refinement, 7 before model
+    # switching checked the dy/dt switching
+    assert out["violation"] == 0
 
 
 def test_model_switching_checks_a_biased_ydot_result():
@@ -84,6 +87,27 @@ def test_model_switching_checks_a_biased_ydot_result():
             assert j["identified"], (i, side, j)
             for k, want in (("a1", p["a1"]), ("b1", p["b1"]), ("c", c), ("d", d)):
                 assert abs(j[k] / want - 1.0) < 1e-3, (i, side, k, j[k], want)
+
+
+def test_output_error_restarts_leave_a_local_minimum():
+    # noise-free cases (defaults, seed 3) where the output-error fit from the switching estimate
+    # stopped in a local minimum (measured before the further starts: b1 4-77 %, d 20-47 % off on
+    # one side, identified; case 168 stopped at 40 passes and was not_excited): its residual is
+    # not white, so further starts run (docs/method.md §A4.4c), and the fit kept is the plant to
+    # 1e-6 on every side it identifies. Case 2's sine never reaches the right edge (330.97 >
+    # 296.6): that side stays unidentified.
+    for i in (2, 148, 168, 479, 726):
+        p, kind, amp, v, y, rng = vp.draw(i, 3, False)
+        r = lash.estimate(np.arange(len(v)) * vp.DT, v, y, model="deadzone-deadband").to_dict()
+        oe = r["output_error"]
+        assert oe["used"] and oe["starts"] > 1 and oe["best_start"] > 0, (i, oe)
+        assert oe["rms"] < 1e-9, (i, oe)  # the record's level: noise-free
+        for side, c, d in (("right", p["cr"], p["dr"]), ("left", p["cl"], p["dl"])):
+            j = r[side]
+            assert j["identified"] == (not (i == 2 and side == "right")), (i, side, j["reason"])
+            if j["identified"]:
+                for k, want in (("a1", p["a1"]), ("b1", p["b1"]), ("c", c), ("d", d)):
+                    assert abs(j[k] / want - 1.0) < 1e-6, (i, side, k, j[k], want)
 
 
 def test_interval_coverage_with_noise():

@@ -309,6 +309,8 @@ std::string estimate_auto_json(const AutoRun& ar, Preset preset, const ReportFit
     if (oe.used)
       o.update({{"converged", oe.fit.converged},
                 {"passes", oe.fit.passes},
+                {"starts", oe.starts},
+                {"best_start", oe.best_start},
                 {"steps", oe.fit.steps},
                 {"residuals", oe.fit.n},
                 {"rms_start", num(oe.fit.rms_start)},

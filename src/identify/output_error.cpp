@@ -19,6 +19,9 @@ namespace {
 constexpr std::size_t P = 8;
 using Mat = std::array<std::array<double, P>, P>;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+/// A fit's residual with a lag-1 autocorrelation above this did not reach the record's noise
+/// level (refine_by_output_error's further starts).
+constexpr double kWhite = 0.5;
 
 /// Solves A x = b for a symmetric positive definite A by Cholesky; false when A is not.
 bool cholesky_solve(Mat a, OutputErrorParams b, OutputErrorParams& x) noexcept {
@@ -53,6 +56,21 @@ bool admissible(const OutputErrorParams& t) noexcept {
          t[6] <= 0.0 && t[3] >= 0.0 && t[7] >= 0.0;
 }
 
+/// v delayed by the model's dead time: push(v(k)) returns v(k − n) (0 before the record).
+class DelayLine {
+ public:
+  explicit DelayLine(std::size_t n) : buf_(n + 1, 0.0) {}
+  double push(double x) noexcept {
+    buf_[i_] = x;
+    i_ = i_ + 1 == buf_.size() ? 0 : i_ + 1;
+    return buf_[i_];
+  }
+
+ private:
+  std::vector<double> buf_;
+  std::size_t i_ = 0;
+};
+
 /// One pass: rᵀr, JᵀJ and Jᵀr at θ (J by forward differences of step h).
 struct Pass {
   double sse = 0.0;
@@ -67,31 +85,32 @@ struct Pass {
 /// The model at θ and at its P forward-difference points θ + h_i e_i.
 template <std::size_t... I>
 std::array<FreeRunDzDb, P + 1> perturbed(const OutputErrorParams& th, const OutputErrorParams& h, bool by_sign,
-                                         std::index_sequence<I...>) {
+                                         bool output_dz, std::index_sequence<I...>) {
   const auto at = [&](std::size_t i) {
     OutputErrorParams t = th;
     if (i > 0) t[i - 1] += h[i - 1];
-    return FreeRunDzDb(t, by_sign);
+    return FreeRunDzDb(t, by_sign, output_dz);
   };
   return {at(I)...};
 }
 
 Pass run_pass(const RecordColumns& rec, const OutputErrorParams& th, const OutputErrorParams& h,
               const OutputErrorOptions& o, std::size_t end) {
-  auto m = perturbed(th, h, o.side_by_sign, std::make_index_sequence<P + 1>{});
+  auto m = perturbed(th, h, o.side_by_sign, o.output_deadzone, std::make_index_sequence<P + 1>{});
   Pass p;
   double v1 = 0.0, r_prev = 0.0;
   bool have_prev = false;
   std::size_t next_edit = 0;
+  DelayLine delay(o.dead_time);
   for_chunks(rec.store, rec.vy, 0, end, [&](std::size_t base, const auto& cols) {
     const auto& v = cols[0];
     const auto& y = cols[1];
     for (std::size_t k = 0; k < v.size(); ++k) {
       std::array<double, P + 1> ys{};
-      for (std::size_t i = 0; i <= P; ++i) ys[i] = m[i].step(v1);
-      v1 = v[k];
+      for (std::size_t i = 0; i <= P; ++i)
+        if (o.fit_d || (i != 4 && i != 8)) ys[i] = m[i].step(v1);  // d held: its points are not run
+      v1 = delay.push(std::isfinite(v[k]) ? v[k] : 0.0);  // a missing input drives nothing
       if (base + k < o.begin || !std::isfinite(y[k]) || !std::isfinite(v[k])) {
-        if (!std::isfinite(v1)) v1 = 0.0;  // a missing input drives nothing
         have_prev = false;
         continue;
       }
@@ -123,16 +142,24 @@ Pass run_pass(const RecordColumns& rec, const OutputErrorParams& th, const Outpu
 
 }  // namespace
 
-FreeRunDzDb::FreeRunDzDb(const OutputErrorParams& th, bool by_sign) noexcept
-    : edge_{th[2], th[6]}, sides_{{th[0], th[1], th[3]}, {th[4], th[5], th[7]}}, by_sign_(by_sign) {}
+FreeRunDzDb::FreeRunDzDb(const OutputErrorParams& th, bool by_sign, bool output_dz) noexcept
+    : edge_{th[2], th[6]},
+      sides_{{th[0], th[1], th[3]}, {th[4], th[5], th[7]}},
+      a1_{th[0], th[4]},
+      b1_{th[1], th[5]},
+      by_sign_(by_sign),
+      output_dz_(output_dz) {}
 
 double FreeRunDzDb::step(double v1) noexcept {
-  y_ = detail::dzdb_free_run(v1, edge_, sides_, by_sign_, last_, w_, y_);
+  y_ = output_dz_ ? detail::output_dz_free_run(v1, edge_, a1_, b1_, last_, w_)
+                  : detail::dzdb_free_run(v1, edge_, sides_, by_sign_, last_, w_, y_);
   return y_;
 }
 
 OutputErrorFit fit_output_error(const RecordColumns& rec, const OutputErrorParams& start,
-                                const OutputErrorOptions& o) {
+                                const OutputErrorOptions& options) {
+  OutputErrorOptions o = options;
+  if (o.output_deadzone) o.fit_d = false;  // the model has no deadband
   OutputErrorFit f;
   f.theta = start;
   f.half95.fill(kNaN);
@@ -232,9 +259,11 @@ void put(OutputErrorParams& th, Side s, const SideParams& p) noexcept {
   const std::size_t b = offset(s);
   th[b] = p.a1, th[b + 1] = p.b1, th[b + 2] = p.c, th[b + 3] = p.d;
 }
-void get(const OutputErrorParams& th, Side s, SideParams& p) noexcept {
+/// `has_d` false (input-deadzone): p.d is left as it is, d is not a parameter of the model.
+void get(const OutputErrorParams& th, Side s, SideParams& p, bool has_d) noexcept {
   const std::size_t b = offset(s);
-  p.a1 = th[b], p.b1 = th[b + 1], p.c = th[b + 2], p.d = th[b + 3];
+  p.a1 = th[b], p.b1 = th[b + 1], p.c = th[b + 2];
+  if (has_d) p.d = th[b + 3];
 }
 
 /// The 95 % intervals of one side from the fit: ±half95 around a1, b1, c, d; K and τ by the delta
@@ -276,14 +305,11 @@ void refine_by_output_error(AutoRun& ar, const RecordColumns& rec, std::size_t b
   OutputErrorReport& out = ar.output_error;
   out = {};
   const EstimatorConfig& cfg = ar.cfg;
-  if (!cfg.output_error || (cfg.model != ModelKind::deadzone_deadband && cfg.model != ModelKind::input_deadzone))
+  if (!cfg.output_error || (cfg.model != ModelKind::deadzone_deadband && cfg.model != ModelKind::input_deadzone &&
+                            cfg.model != ModelKind::output_deadzone))
     return;
-  const bool has_d = cfg.model == ModelKind::deadzone_deadband;  // input-deadzone: d = 0 held
+  const bool has_d = cfg.model == ModelKind::deadzone_deadband;  // the others: d = 0 held
   out.tried = true;
-  if (cfg.noise.dead_time != 0) {
-    out.why_not = "the model has a dead time (the free run of the refinement has none)";
-    return;
-  }
   EstimateReport& rep = ar.run.report;
   // the start: the sides' estimates; a side without one (a check on its values or its updates
   // failed) starts from the other side's dynamics and deadband with its edge mirrored (the free
@@ -320,8 +346,55 @@ void refine_by_output_error(AutoRun& ar, const RecordColumns& rec, std::size_t b
   o.edit_values = edit_values;
   o.side_by_sign = true;  // the plant's structure (eq. 34, blocks/deadband.hpp): the side of the sign of v(k−1)
   o.fit_d = has_d;
+  o.output_deadzone = cfg.model == ModelKind::output_deadzone;
+  o.dead_time = cfg.noise.dead_time;
   if (!has_d) start[3] = start[7] = 0.0;
+  // The starts (the free run's cost is not convex in θ: an edge the input passes only a little
+  // and a deadband that hides most of a side's motion leave local minima). First the estimate.
+  // From that fit's result: each side's a1, b1, d given to the other (its own edge kept: the two
+  // sides of a real actuator share most of their dynamics), each side's d doubled and halved
+  // (a deadband's width moves the cost in steps where the output turns); and the model
+  // switching's model. The fit of lowest cost is kept. The further starts run only when the
+  // first fit did not reach the record's level: its residual's lag-1 autocorrelation above
+  // kWhite (a white measurement noise gives |ρ1| ~ 1/√n), or no convergence in max_passes.
   out.fit = fit_output_error(rec, start, o);
+  out.starts = 1;
+  std::vector<OutputErrorParams> starts;
+  const OutputErrorParams first = out.fit.theta;
+  const auto lend = [&](std::size_t from, std::size_t to) {
+    OutputErrorParams t = first;
+    t[to] = first[from], t[to + 1] = first[from + 1], t[to + 3] = first[from + 3];
+    if (t != first) starts.push_back(t);
+  };
+  lend(0, 4);
+  lend(4, 0);
+  if (has_d)
+    for (const std::size_t i : {3u, 7u})
+      for (const double scale : {2.0, 0.5}) {
+        OutputErrorParams t = first;
+        t[i] *= scale;
+        if (t != first) starts.push_back(t);
+      }
+  const auto& sw = cfg.switch_model;
+  if (ar.switching.used && sw.right.usable() && sw.left.usable()) {
+    OutputErrorParams t{sw.right.a1, sw.right.b1, sw.right.c, sw.right.d, sw.left.a1, sw.left.b1, sw.left.c, sw.left.d};
+    if (!has_d) t[3] = t[7] = 0.0;
+    if (t != start) starts.push_back(t);
+  }
+  if (out.fit.ok && (out.fit.rho1 > kWhite || !out.fit.converged))
+    for (std::size_t i = 0; i < starts.size(); ++i) {
+      if (!admissible(starts[i])) continue;
+      OutputErrorFit g = fit_output_error(rec, starts[i], o);
+      ++out.starts;
+      if (g.ok && g.rms < out.fit.rms) {
+        g.rms_start = out.fit.rms_start;  // the estimate's, as the report says
+        g.passes += out.fit.passes;
+        out.fit = g;
+        out.best_start = out.starts - 1;
+      } else {
+        out.fit.passes += g.passes;
+      }
+    }
   const OutputErrorFit& f = out.fit;
   if (!f.ok) {
     out.why_not = admissible(start) ? "the fit failed (too few rows in the window, or a non-finite pass)"
@@ -337,9 +410,7 @@ void refine_by_output_error(AutoRun& ar, const RecordColumns& rec, std::size_t b
   for (const Side s : {Side::right, Side::left}) {
     SideReport& r = rep[s];
     const std::size_t b = offset(s);
-    const double d_before = r.params.d;
-    get(f.theta, s, r.params);
-    if (!has_d) r.params.d = d_before;  // not a parameter of the model
+    get(f.theta, s, r.params, has_d);
     r.K = static_gain(r.params.a1, r.params.b1);
     r.tau_s = time_constant_s(r.params.a1, cfg.dt_s);
     {  // checks 3–6 again on the new values; check 2 on the fit's information (JᵀJ)
@@ -361,13 +432,14 @@ void refine_by_output_error(AutoRun& ar, const RecordColumns& rec, std::size_t b
     attach_intervals(rep, {fit_intervals(f, Side::right, cfg.dt_s), fit_intervals(f, Side::left, cfg.dt_s)},
                      cfg.ci_tolerance);
   if (!ar.run.ysim.empty()) {  // the stored free run: the refined model's
-    FreeRunDzDb m(f.theta, o.side_by_sign);  // the rule the fit used
+    FreeRunDzDb m(f.theta, o.side_by_sign, o.output_deadzone);  // the rule the fit used
+    DelayLine delay(o.dead_time);
     double v1 = 0.0;
     for_chunks(rec.store, rec.vy, 0, std::min(rec.size(), ar.run.ysim.size()),
                [&](std::size_t base, const auto& cols) {
                  for (std::size_t k = 0; k < cols[0].size(); ++k) {
                    ar.run.ysim[base + k] = m.step(v1);
-                   v1 = std::isfinite(cols[0][k]) ? cols[0][k] : 0.0;
+                   v1 = delay.push(std::isfinite(cols[0][k]) ? cols[0][k] : 0.0);
                  }
                });
   }

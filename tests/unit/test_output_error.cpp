@@ -94,6 +94,67 @@ TEST(OutputError, NoiseFreeFitFromAStartSeveralPercentOffReturnsThePlant) {
   for (std::size_t i = 0; i < 8; ++i) EXPECT_NEAR(f.theta[i], kTruth[i], 1e-6 * std::fabs(kTruth[i])) << "theta " << i;
 }
 
+// A dead time of n samples (NoiseSettings::dead_time): the plant driven by v delayed by n
+// (v(k - n), 0 before the record) is fitted with OutputErrorOptions::dead_time = n; without it
+// the same start stops far from the plant.
+TEST(OutputError, ADeadTimeDelaysTheFreeRunsInput) {
+  const auto v = multisine();
+  constexpr std::size_t kDead = 2;
+  std::vector<double> vd(v.size(), 0.0);
+  for (std::size_t k = kDead; k < v.size(); ++k) vd[k] = v[k - kDead];
+  const auto y = plant_output(vd);
+  OutputErrorParams start = kTruth;
+  const double off[8] = {1.003, 1.10, 0.95, 1.08, 1.002, 0.92, 1.06, 0.93};
+  for (std::size_t i = 0; i < 8; ++i) start[i] *= off[i];
+  OutputErrorOptions o = by_sign();
+  o.dead_time = kDead;
+  const OutputErrorFit f = fit_output_error(RecordColumns::of(v, y), start, o);
+  ASSERT_TRUE(f.ok);
+  EXPECT_TRUE(f.converged);
+  EXPECT_LT(f.rms, 1e-6);
+  for (std::size_t i = 0; i < 8; ++i) EXPECT_NEAR(f.theta[i], kTruth[i], 1e-6 * std::fabs(kTruth[i])) << "theta " << i;
+  const OutputErrorFit g = fit_output_error(RecordColumns::of(v, y), start, by_sign());
+  ASSERT_TRUE(g.ok);
+  EXPECT_GT(g.rms, 0.1);  // one sample of lag instead of three: a misfit the residual shows
+}
+
+// The output-deadzone model (G -> DZ, the motor cart's Coulomb friction on the output;
+// OutputErrorOptions::output_deadzone): lash's FirstOrder then Deadzone blocks, edges +60 / -45 in
+// the output's unit. The free run of the plant's parameters is the plant; from a start with the
+// edges 30 % off and the lag 0.2 % (tau 7 %) off, the noise-free fit returns it; d is not fitted.
+TEST(OutputError, TheOutputDeadzoneModelIsFittedOnItsSixParameters) {
+  constexpr OutputErrorParams kOut{-0.97, 0.045, 60.0, 0.0, -0.97, 0.045, -45.0, 0.0};
+  const auto v = multisine();
+  FirstOrder g(PerSide<FirstOrderParams>::both({kOut[0], kOut[1]}));
+  Deadzone dz({kOut[6], kOut[2]});
+  std::vector<double> y(v.size(), 0.0);
+  double peak = 0.0;
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    y[k] = dz.step(g.step(v[k]));  // x(k) from v(k-1)
+    peak = std::max(peak, std::fabs(y[k]));
+  }
+  EXPECT_GT(peak, 200.0);
+  FreeRunDzDb run(kOut, false, true);
+  double worst = 0.0;
+  for (std::size_t k = 0; k < v.size(); ++k) worst = std::max(worst, std::fabs(run.step(k > 0 ? v[k - 1] : 0.0) - y[k]));
+  EXPECT_LT(worst, 1e-9 * peak);
+  OutputErrorParams start = kOut;
+  const double off[8] = {1.002, 0.9, 1.3, 1.0, 0.998, 1.1, 0.7, 1.0};
+  for (std::size_t i = 0; i < 8; ++i) start[i] *= off[i];
+  OutputErrorOptions o;
+  o.output_deadzone = true;
+  o.fit_d = true;  // ignored: the model has no deadband
+  const OutputErrorFit f = fit_output_error(RecordColumns::of(v, y), start, o);
+  ASSERT_TRUE(f.ok);
+  EXPECT_TRUE(f.converged);
+  EXPECT_GT(f.rms_start, 1.0);
+  EXPECT_LT(f.rms, 1e-6);
+  for (const std::size_t i : {0u, 1u, 2u, 4u, 5u, 6u}) EXPECT_NEAR(f.theta[i], kOut[i], 1e-6 * std::fabs(kOut[i])) << i;
+  EXPECT_EQ(f.theta[3], 0.0);
+  EXPECT_EQ(f.theta[7], 0.0);
+  EXPECT_TRUE(std::isnan(f.half95[3]) && std::isnan(f.half95[7]));
+}
+
 struct Scatter {
   std::array<double, 8> sd_over_predicted{}, bias_over_sd{};
   int inside = 0, intervals = 0;

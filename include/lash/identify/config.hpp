@@ -164,8 +164,8 @@ struct DeadzoneDeadbandSettings {
   /// ẏ and the guesses; pooled only. `lash estimate` iterates it by itself when the ẏ switching
   /// leaves a side unidentified; true makes it iterate on every record.
   bool model_switching = false;
-  /// Output-error refinement (docs/method.md §A4.4c; deadzone-deadband and input-deadzone, the
-  /// latter with d = 0 held): after the switching estimate, move the parameters of both sides to
+  /// Output-error refinement (docs/method.md §A4.4c; deadzone-deadband, input-deadzone and
+  /// output-deadzone, the latter two with d = 0 held): after the switching estimate, move the parameters of both sides to
   /// minimise the free run's error over the NRMSE window
   /// (Levenberg–Marquardt, identify/output_error.hpp) and judge and bound the result. Offline
   /// only (whole-record passes); the online estimator refuses it.

@@ -101,6 +101,17 @@ struct DzDbSide {
   if (w > y + m.d) return w - m.d;
   return y;
 }
+/// One step of the output-deadzone model's free run (G → DZ, §A4.3): the side of the linear
+/// part's output x against the edges (free_run_side, updates `last`), x ← −a1·x + b1·v1, and the
+/// output DZ(x). The estimator's free run (models/output_deadzone.cpp) and the output-error fit
+/// step this one function.
+[[gnu::always_inline]] constexpr double output_dz_free_run(double v1, const PerSide<double>& edge,
+                                                          const PerSide<double>& a1, const PerSide<double>& b1,
+                                                          Side& last, double& x) noexcept {
+  last = free_run_side(x, edge, last);
+  x = -a1[last] * x + b1[last] * v1;
+  return deadzone(x, edge.left, edge.right);
+}
 /// Input-side switching (eq. 18): right when v(k−1) > c_r*, left when v(k−1) < c_l*, none inside.
 constexpr std::optional<Side> guess_side(double v1, const EstimatorConfig& c) noexcept {
   if (v1 > c.guess_right) return Side::right;

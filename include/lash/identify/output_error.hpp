@@ -1,8 +1,8 @@
 #pragma once
 /// @file output_error.hpp
-/// Output-error refinement of a deadzone-deadband or input-deadzone estimate over a whole record
-/// (docs/method.md §A4.4c): the parameters θ = (a1, b1, c, d) of each side (input-deadzone: d = 0
-/// held) are moved to minimise the sum of squares of y − y_sim(θ), the free run of the model driven by v alone (the verdict's
+/// Output-error refinement of a deadzone-deadband, input-deadzone or output-deadzone estimate over
+/// a whole record (docs/method.md §A4.4c): the parameters θ = (a1, b1, c, d) of each side (input-
+/// and output-deadzone: d = 0 held; output-deadzone with its own free run, G → DZ) are moved to minimise the sum of squares of y − y_sim(θ), the free run of the model driven by v alone (the verdict's
 /// simulation, eq. 36 of the thesis; the refinement takes the side of the sign of v(k−1), eq. 34,
 /// the rule of lash's plant blocks/deadband.hpp), by Levenberg–Marquardt
 /// from the switching estimate. Why: the switching RLS regresses y(k) on the measured y(k−1);
@@ -34,8 +34,14 @@ using OutputErrorParams = std::array<double, 8>;
 struct OutputErrorOptions {
   std::size_t begin = 0;       ///< first row whose residual is summed (the fit window's start)
   std::size_t end = 0;         ///< one past the last (0: the record's end)
-  int max_passes = 40;         ///< passes over the record at most
+  int max_passes = 100;        ///< passes over the record at most
   bool side_by_sign = false;   ///< the free run's side by the sign of v (EstimatorConfig::sim_side_by_sign)
+  /// The model's dead time [samples]: y_sim(k) from v(k − 1 − dead_time) (NoiseSettings::dead_time).
+  std::size_t dead_time = 0;
+  /// The output-deadzone model's free run (G → DZ, detail::output_dz_free_run) instead of
+  /// deadzone → G → deadband: c is the edge on the linear part's output [y unit], d is unused
+  /// (fit_d must be false), side_by_sign is not read (the side is the output's against the edges).
+  bool output_deadzone = false;
   /// false: d_r, d_l stay at their start values (input-deadzone: 0, the model has no deadband);
   /// only a1, b1, c of each side are fitted and their half-widths of d are NaN.
   bool fit_d = true;
@@ -71,17 +77,19 @@ struct OutputErrorFit {
 };
 
 /// The model's free run at θ from rest (w = y_sim = 0, the right side first), one sample at a
-/// time: y_sim(k) from v up to k − 1, the estimators' free run (detail::dzdb_free_run).
+/// time: y_sim(k) from v up to k − 1, the estimators' free run (detail::dzdb_free_run; with
+/// `output_dz`, detail::output_dz_free_run).
 class FreeRunDzDb {
  public:
-  FreeRunDzDb(const OutputErrorParams& th, bool by_sign) noexcept;
+  FreeRunDzDb(const OutputErrorParams& th, bool by_sign, bool output_dz = false) noexcept;
   /// y_sim(k) given v(k − 1).
   double step(double v1) noexcept;
 
  private:
   PerSide<double> edge_{};
   PerSide<detail::DzDbSide> sides_{};
-  bool by_sign_ = false;
+  PerSide<double> a1_{}, b1_{};  // output_dz: the sides' linear parts
+  bool by_sign_ = false, output_dz_ = false;
   Side last_ = Side::right;
   double w_ = 0.0, y_ = 0.0;
 };
@@ -93,10 +101,12 @@ OutputErrorFit fit_output_error(const RecordColumns& record, const OutputErrorPa
 
 /// What the refinement of a run did (AutoRun::output_error; the JSON's "output_error").
 struct OutputErrorReport {
-  bool tried = false;          ///< the setting was on and the model is deadzone-deadband
+  bool tried = false;          ///< the setting was on and the model is one the fit has
   bool used = false;           ///< the refined parameters replaced the switching estimate's
   const char* why_not = "";    ///< when tried and not used: why (a fixed text)
-  OutputErrorFit fit;
+  int starts = 0;              ///< fits run (refine_by_output_error's starts)
+  int best_start = 0;          ///< the start whose fit was kept (0: the estimate)
+  OutputErrorFit fit;          ///< the kept fit (passes: of all the starts)
 };
 
 struct AutoRun;
@@ -106,15 +116,20 @@ struct EstimatorConfig;
 /// InputError naming `output-error` when it is on (`where`: what the user should use instead).
 void refuse_output_error_online(const EstimatorConfig& cfg, const char* where);
 
-/// With cfg.output_error on a deadzone-deadband or input-deadzone run (the latter: d = 0 held):
+/// With cfg.output_error on a deadzone-deadband, input-deadzone or output-deadzone run (the latter
+/// two: d = 0 held; output-deadzone: OutputErrorOptions::output_deadzone):
 /// fits rows [begin, end) of `record` from the run's estimate (a side without one starts from the
-/// other side's, its edge mirrored) and, when the fit is ok, puts its parameters (and K, τ) in the report, the free run's NRMSE over those
-/// rows in the report's fit and the run's score, the refined free run in the stored y_sim, and
-/// judges both sides again: checks 3–6 on the new values, check 2 on the fit's information (a
-/// side whose JᵀJ block is singular is not_excited). With `intervals`, the fit's 95 % intervals
-/// replace the batch means' and checks 7–8 run on them. Not used (why_not says why): a dead
-/// time, a side not_excited by the switching run's checks (its input held one level or one
-/// value), no side with finite parameters, a start the free run cannot hold, or a failed fit.
+/// other side's, its edge mirrored; the free run delayed by cfg.noise.dead_time) and, when the
+/// first fit's residual is not white or it did not converge, from further starts (the sides'
+/// dynamics exchanged, each d doubled and halved, the model switching's model; the fit of lowest
+/// cost is kept, docs/method.md §A4.4c). When the fit is ok, puts its parameters (and K, τ) in
+/// the report, the free run's NRMSE over those rows in the report's fit and the run's score, the
+/// refined free run in the stored y_sim, and judges both sides again: checks 3–6 on the new
+/// values, check 2 on the fit's information (a side whose JᵀJ block is singular is
+/// not_excited). With `intervals`, the fit's 95 % intervals replace the batch means' and checks
+/// 7–8 run on them. Not used (why_not says why): a side not_excited by the switching run's
+/// checks (its input held one level or one value), no side with finite parameters, a start the
+/// free run cannot hold, or a failed fit.
 /// `gate`: the outlier gate's threshold of the run (AutoOptions::gate; 0 = off): the fit reads y
 /// with the gate's replacements, the NRMSE is taken against y as given.
 void refine_by_output_error(AutoRun& run, const RecordColumns& record, std::size_t begin, std::size_t end,
