@@ -259,7 +259,7 @@ void put(OutputErrorParams& th, Side s, const SideParams& p) noexcept {
   const std::size_t b = offset(s);
   th[b] = p.a1, th[b + 1] = p.b1, th[b + 2] = p.c, th[b + 3] = p.d;
 }
-/// `has_d` false (input-deadzone): p.d is left as it is, d is not a parameter of the model.
+/// `has_d` false (input-, output-deadzone): p.d is left as it is, d is not a parameter of the model.
 void get(const OutputErrorParams& th, Side s, SideParams& p, bool has_d) noexcept {
   const std::size_t b = offset(s);
   p.a1 = th[b], p.b1 = th[b + 1], p.c = th[b + 2];
