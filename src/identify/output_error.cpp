@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "lash/blocks/delay.hpp"
 #include "lash/identify/auto.hpp"
 #include "lash/io/error.hpp"
 #include "lash/identify/estimator_skeleton.hpp"
@@ -56,21 +57,6 @@ bool admissible(const OutputErrorParams& t) noexcept {
          t[6] <= 0.0 && t[3] >= 0.0 && t[7] >= 0.0;
 }
 
-/// v delayed by the model's dead time: push(v(k)) returns v(k − n) (0 before the record).
-class DelayLine {
- public:
-  explicit DelayLine(std::size_t n) : buf_(n + 1, 0.0) {}
-  double push(double x) noexcept {
-    buf_[i_] = x;
-    i_ = i_ + 1 == buf_.size() ? 0 : i_ + 1;
-    return buf_[i_];
-  }
-
- private:
-  std::vector<double> buf_;
-  std::size_t i_ = 0;
-};
-
 /// One pass: rᵀr, JᵀJ and Jᵀr at θ (J by forward differences of step h).
 struct Pass {
   double sse = 0.0;
@@ -101,7 +87,7 @@ Pass run_pass(const RecordColumns& rec, const OutputErrorParams& th, const Outpu
   double v1 = 0.0, r_prev = 0.0;
   bool have_prev = false;
   std::size_t next_edit = 0;
-  DelayLine delay(o.dead_time);
+  Delay delay(o.dead_time);  // v(k − dead_time), 0 before the record
   for_chunks(rec.store, rec.vy, 0, end, [&](std::size_t base, const auto& cols) {
     const auto& v = cols[0];
     const auto& y = cols[1];
@@ -109,7 +95,7 @@ Pass run_pass(const RecordColumns& rec, const OutputErrorParams& th, const Outpu
       std::array<double, P + 1> ys{};
       for (std::size_t i = 0; i <= P; ++i)
         if (o.fit_d || (i != 4 && i != 8)) ys[i] = m[i].step(v1);  // d held: its points are not run
-      v1 = delay.push(std::isfinite(v[k]) ? v[k] : 0.0);  // a missing input drives nothing
+      v1 = delay.step(std::isfinite(v[k]) ? v[k] : 0.0);  // a missing input drives nothing
       if (base + k < o.begin || !std::isfinite(y[k]) || !std::isfinite(v[k])) {
         have_prev = false;
         continue;
@@ -433,13 +419,13 @@ void refine_by_output_error(AutoRun& ar, const RecordColumns& rec, std::size_t b
                      cfg.ci_tolerance);
   if (!ar.run.ysim.empty()) {  // the stored free run: the refined model's
     FreeRunDzDb m(f.theta, o.side_by_sign, o.output_deadzone);  // the rule the fit used
-    DelayLine delay(o.dead_time);
+    Delay delay(o.dead_time);
     double v1 = 0.0;
     for_chunks(rec.store, rec.vy, 0, std::min(rec.size(), ar.run.ysim.size()),
                [&](std::size_t base, const auto& cols) {
                  for (std::size_t k = 0; k < cols[0].size(); ++k) {
                    ar.run.ysim[base + k] = m.step(v1);
-                   v1 = delay.push(std::isfinite(cols[0][k]) ? cols[0][k] : 0.0);
+                   v1 = delay.step(std::isfinite(cols[0][k]) ? cols[0][k] : 0.0);
                  }
                });
   }

@@ -59,6 +59,13 @@ std::vector<double> plant_output(const std::vector<double>& v) {
   return y;
 }
 
+// `truth` with each parameter times its factor in `off` (a start some per cent away)
+OutputErrorParams scaled(OutputErrorParams truth, const std::array<double, 8>& off) {
+  for (std::size_t i = 0; i < 8; ++i) truth[i] *= off[i];
+  return truth;
+}
+constexpr std::array<double, 8> kOff{1.003, 1.10, 0.95, 1.08, 1.002, 0.92, 1.06, 0.93};  // a1 by 0.3 %: tau 10 %
+
 OutputErrorOptions by_sign() {
   OutputErrorOptions o;
   o.side_by_sign = true;
@@ -82,9 +89,7 @@ TEST(OutputError, FreeRunOfThePlantsParametersIsThePlant) {
 TEST(OutputError, NoiseFreeFitFromAStartSeveralPercentOffReturnsThePlant) {
   const auto v = multisine();
   const auto y = plant_output(v);
-  OutputErrorParams start = kTruth;
-  const double off[8] = {1.003, 1.10, 0.95, 1.08, 1.002, 0.92, 1.06, 0.93};  // a1 by 0.3 %: tau 10 %
-  for (std::size_t i = 0; i < 8; ++i) start[i] *= off[i];
+  const OutputErrorParams start = scaled(kTruth, kOff);
   const OutputErrorFit f = fit_output_error(RecordColumns::of(v, y), start, by_sign());
   ASSERT_TRUE(f.ok);
   EXPECT_TRUE(f.converged);
@@ -103,9 +108,7 @@ TEST(OutputError, ADeadTimeDelaysTheFreeRunsInput) {
   std::vector<double> vd(v.size(), 0.0);
   for (std::size_t k = kDead; k < v.size(); ++k) vd[k] = v[k - kDead];
   const auto y = plant_output(vd);
-  OutputErrorParams start = kTruth;
-  const double off[8] = {1.003, 1.10, 0.95, 1.08, 1.002, 0.92, 1.06, 0.93};
-  for (std::size_t i = 0; i < 8; ++i) start[i] *= off[i];
+  const OutputErrorParams start = scaled(kTruth, kOff);
   OutputErrorOptions o = by_sign();
   o.dead_time = kDead;
   const OutputErrorFit f = fit_output_error(RecordColumns::of(v, y), start, o);
@@ -138,9 +141,7 @@ TEST(OutputError, TheOutputDeadzoneModelIsFittedOnItsSixParameters) {
   double worst = 0.0;
   for (std::size_t k = 0; k < v.size(); ++k) worst = std::max(worst, std::fabs(run.step(k > 0 ? v[k - 1] : 0.0) - y[k]));
   EXPECT_LT(worst, 1e-9 * peak);
-  OutputErrorParams start = kOut;
-  const double off[8] = {1.002, 0.9, 1.3, 1.0, 0.998, 1.1, 0.7, 1.0};
-  for (std::size_t i = 0; i < 8; ++i) start[i] *= off[i];
+  const OutputErrorParams start = scaled(kOut, {1.002, 0.9, 1.3, 1.0, 0.998, 1.1, 0.7, 1.0});
   OutputErrorOptions o;
   o.output_deadzone = true;
   o.fit_d = true;  // ignored: the model has no deadband
@@ -237,10 +238,8 @@ TEST(OutputError, WithDHeldTheInputDeadzonePlantIsFittedOnItsSixParameters) {
   FirstOrder g(PerSide<FirstOrderParams>::both({kTruth[0], kTruth[1]}));
   std::vector<double> y(v.size());
   for (std::size_t k = 0; k < v.size(); ++k) y[k] = g.step(dz.step(v[k]));
-  OutputErrorParams start = kTruth;
+  OutputErrorParams start = scaled(kTruth, kOff);
   start[3] = start[7] = 0.0;
-  const double off[8] = {1.003, 1.10, 0.95, 1.0, 1.002, 0.92, 1.06, 1.0};
-  for (std::size_t i = 0; i < 8; ++i) start[i] *= off[i];
   OutputErrorOptions o = by_sign();
   o.fit_d = false;
   const OutputErrorFit f = fit_output_error(RecordColumns::of(v, y), start, o);
