@@ -78,7 +78,7 @@ EstimateSettings resolve_settings(const SettingsSources& src, double dt_s, const
       tune_to_data(cfg, *out.traits);
     }
   }
-  if (src.follows_drift) cfg.output_error = false;
+  if (src.follows_drift) cfg.output_error = cfg.output_error_check = false;
   if (file) {
     TomlTable t(*file, src.config_file);
     (void)t.string_opt("preset");

@@ -143,7 +143,7 @@ ArrayEstimate estimate_record(const SettingsSources& src, const RecordColumns& r
     attach_intervals(out.run.run.report, *out.run.ci95, out.run.cfg.ci_tolerance);
   else if (o.intervals)
     add_intervals(out.run.run, out.run.cfg, rec, smp.gap_rows);
-  refine_by_output_error(out.run, rec, ao.score_begin, ao.score_end, o.intervals, ao.gate);
+  refine_by_output_error(out.run, rec, ao.score_begin, ao.score_end, o.intervals, ao.gate, smp.gap_rows);
   scored.report = out.run.run.report;
   scored.nrmse = out.run.run.score.value();
   out.result = std::move(scored);

@@ -319,6 +319,13 @@ std::string estimate_auto_json(const AutoRun& ar, Preset preset, const ReportFit
                 {"variance_factor", num(oe.fit.variance_factor)}});
     else
       o["why_not"] = oe.why_not;
+    if (oe.check) {  // output_error_check: what the fit from the estimate moved
+      Json c{{"rms_start", num(oe.fit.rms_start)}, {"rms", num(oe.fit.rms)}, {"passes", oe.fit.passes}};
+      for (const auto& [name, i] : {std::pair{"right", 0}, std::pair{"left", 1}})
+        c[name] = oe.moved[i] < 0 ? Json(nullptr)
+                                  : Json{{"moved", side_param_name(oe.moved[i])}, {"by", num(oe.moved_by[i])}};
+      o["check"] = c;
+    }
     j["output_error"] = o;
   }
   j["preset"] = to_string(preset);
@@ -353,6 +360,11 @@ std::string estimate_auto_text(const AutoRun& ar, double dt_s, const ReportFit& 
                                  oe.fit.converged ? "converged" : "did not converge", oe.fit.passes, oe.fit.steps,
                                  oe.fit.rms_start, oe.fit.rms)
                    : fmt::format("output error: not used ({})\n", oe.why_not);
+    for (const auto& [name, i] : {std::pair{"right", 0}, std::pair{"left", 1}})
+      if (oe.check && oe.moved[i] >= 0)
+        out += fmt::format("output error check: the fit from this estimate moves the {} side's {} by {:.3g} %: "
+                           "reported poor_fit (use lash's preset, or --output-error, for the refined estimate)\n",
+                           name, side_param_name(oe.moved[i]), 100.0 * oe.moved_by[i]);
   }
   return out;
 }

@@ -20,6 +20,7 @@ namespace {
 constexpr std::size_t P = 8;
 using Mat = std::array<std::array<double, P>, P>;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
 /// A fit's residual with a lag-1 autocorrelation above this did not reach the record's noise
 /// level (refine_by_output_error's further starts).
 constexpr double kWhite = 0.5;
@@ -86,23 +87,31 @@ Pass run_pass(const RecordColumns& rec, const OutputErrorParams& th, const Outpu
   Pass p;
   double v1 = 0.0, r_prev = 0.0;
   bool have_prev = false;
-  std::size_t next_edit = 0;
+  std::size_t next_edit = 0, next_gap = 0, settled = o.begin;
   Delay delay(o.dead_time);  // v(k − dead_time), 0 before the record
   for_chunks(rec.store, rec.vy, 0, end, [&](std::size_t base, const auto& cols) {
     const auto& v = cols[0];
     const auto& y = cols[1];
     for (std::size_t k = 0; k < v.size(); ++k) {
+      const std::size_t row = base + k;
+      while (next_edit < o.edit_rows.size() && o.edit_rows[next_edit] < row) ++next_edit;
+      const bool edited = next_edit < o.edit_rows.size() && o.edit_rows[next_edit] == row;
+      const double yk = edited ? o.edit_values[next_edit] : y[k];
+      while (next_gap < o.restart_rows.size() && o.restart_rows[next_gap] < row) ++next_gap;
+      const bool gap = next_gap < o.restart_rows.size() && o.restart_rows[next_gap] == row && row > 0;
       std::array<double, P + 1> ys{};
+      if (gap) {  // the plant is where y says, its input history unknown: as at the record's start
+        delay.reset();
+        settled = std::max(settled, row + 1 + o.restart_settle);
+      }
       for (std::size_t i = 0; i <= P; ++i)
-        if (o.fit_d || (i != 4 && i != 8)) ys[i] = m[i].step(v1);  // d held: its points are not run
+        if (o.fit_d || (i != 4 && i != 8))  // d held: its points are not run
+          ys[i] = gap ? m[i].restart(std::isfinite(yk) ? yk : 0.0) : m[i].step(v1);
       v1 = delay.step(std::isfinite(v[k]) ? v[k] : 0.0);  // a missing input drives nothing
-      if (base + k < o.begin || !std::isfinite(y[k]) || !std::isfinite(v[k])) {
+      if (row < settled || !std::isfinite(y[k]) || !std::isfinite(v[k])) {
         have_prev = false;
         continue;
       }
-      double yk = y[k];
-      while (next_edit < o.edit_rows.size() && o.edit_rows[next_edit] < base + k) ++next_edit;
-      if (next_edit < o.edit_rows.size() && o.edit_rows[next_edit] == base + k) yk = o.edit_values[next_edit];
       const double r = yk - ys[0];
       p.sse += r * r;
       if (have_prev) p.lag1 += r * r_prev;
@@ -139,6 +148,13 @@ FreeRunDzDb::FreeRunDzDb(const OutputErrorParams& th, bool by_sign, bool output_
 double FreeRunDzDb::step(double v1) noexcept {
   y_ = output_dz_ ? detail::output_dz_free_run(v1, edge_, a1_, b1_, last_, w_)
                   : detail::dzdb_free_run(v1, edge_, sides_, by_sign_, last_, w_, y_);
+  return y_;
+}
+
+double FreeRunDzDb::restart(double y) noexcept {
+  if (output_dz_) w_ = y > 0.0 ? y + edge_.right : y < 0.0 ? y + edge_.left : 0.0;
+  else w_ = y;
+  y_ = y;
   return y_;
 }
 
@@ -276,7 +292,48 @@ SideIntervals fit_intervals(const OutputErrorFit& f, Side side, double dt_s) {
   }
   return ci;
 }
+
+/// output_error_check: the estimate stays; an identified side the fit (out.fit, from the
+/// estimate) moves beyond both bounds in any of its parameters is reported poor_fit.
+void check_estimate(AutoRun& ar, bool has_d) {
+  OutputErrorReport& out = ar.output_error;
+  out.check = true;
+  const OutputErrorFit& f = out.fit;
+  if (!f.ok) {
+    out.why_not = "check: the fit failed (too few rows in the window, or a non-finite pass)";
+    return;
+  }
+  out.why_not = "check only (output-error-check): the switching estimate is kept";
+  if (!(f.rms_start * f.rms_start > (1.0 + kCheckCost) * f.rms * f.rms)) return;  // no material gain
+  EstimateReport& rep = ar.run.report;
+  for (const Side s : {Side::right, Side::left}) {
+    SideParams& p = rep[s].params;
+    if (!p.identified) continue;
+    const std::size_t b = offset(s);
+    const std::array<double, 4> est{p.a1, p.b1, p.c, p.d};
+    const std::size_t si = s == Side::right ? 0 : 1;
+    for (std::size_t i = 0; i < (has_d ? 4u : 3u); ++i) {
+      const double diff = std::fabs(f.theta[b + i] - est[i]);
+      const double hw = std::isfinite(f.half95[b + i]) ? f.half95[b + i] : 0.0;
+      const double by = est[i] != 0.0 ? diff / std::fabs(est[i]) : kInf;
+      if (diff > std::max(kCheckMove * std::fabs(est[i]), kCheckHalfWidths * hw) && by > out.moved_by[si]) {
+        out.moved[si] = static_cast<int>(i);
+        out.moved_by[si] = by;
+      }
+    }
+    if (out.moved[si] >= 0) {
+      p.identified = false;
+      p.reason = Reason::poor_fit;
+      rep.identified = false;
+    }
+  }
+}
 }  // namespace
+
+const char* side_param_name(int i) noexcept {
+  static constexpr const char* names[] = {"a1", "b1", "c", "d"};
+  return i >= 0 && i < 4 ? names[i] : "";
+}
 
 void refuse_output_error_online(const EstimatorConfig& cfg, const char* where) {
   if (cfg.output_error)
@@ -287,11 +344,11 @@ void refuse_output_error_online(const EstimatorConfig& cfg, const char* where) {
 }
 
 void refine_by_output_error(AutoRun& ar, const RecordColumns& rec, std::size_t begin, std::size_t end,
-                            bool intervals, double gate) {
+                            bool intervals, double gate, std::span<const std::size_t> gap_rows) {
   OutputErrorReport& out = ar.output_error;
   out = {};
   const EstimatorConfig& cfg = ar.cfg;
-  if (!cfg.output_error || (cfg.model != ModelKind::deadzone_deadband && cfg.model != ModelKind::input_deadzone &&
+  if (!(cfg.output_error || cfg.output_error_check) || (cfg.model != ModelKind::deadzone_deadband && cfg.model != ModelKind::input_deadzone &&
                             cfg.model != ModelKind::output_deadzone))
     return;
   const bool has_d = cfg.model == ModelKind::deadzone_deadband;  // the others: d = 0 held
@@ -330,6 +387,8 @@ void refine_by_output_error(AutoRun& ar, const RecordColumns& rec, std::size_t b
   if (ar.outliers > 0) gate_outliers(rec, gate, edit_rows, edit_values);  // the run's replacements again
   o.edit_rows = edit_rows;
   o.edit_values = edit_values;
+  o.restart_rows = gap_rows;
+  o.restart_settle = begin;  // after a gap, the allowance the record's start gets
   o.side_by_sign = true;  // the plant's structure (eq. 34, blocks/deadband.hpp): the side of the sign of v(k−1)
   o.fit_d = has_d;
   o.output_deadzone = cfg.model == ModelKind::output_deadzone;
@@ -345,6 +404,10 @@ void refine_by_output_error(AutoRun& ar, const RecordColumns& rec, std::size_t b
   // kWhite (a white measurement noise gives |ρ1| ~ 1/√n), or no convergence in max_passes.
   out.fit = fit_output_error(rec, start, o);
   out.starts = 1;
+  if (!cfg.output_error) {
+    check_estimate(ar, has_d);
+    return;
+  }
   std::vector<OutputErrorParams> starts;
   const OutputErrorParams first = out.fit.theta;
   const auto lend = [&](std::size_t from, std::size_t to) {
@@ -421,10 +484,18 @@ void refine_by_output_error(AutoRun& ar, const RecordColumns& rec, std::size_t b
     FreeRunDzDb m(f.theta, o.side_by_sign, o.output_deadzone);  // the rule the fit used
     Delay delay(o.dead_time);
     double v1 = 0.0;
+    std::size_t next_gap = 0;
     for_chunks(rec.store, rec.vy, 0, std::min(rec.size(), ar.run.ysim.size()),
                [&](std::size_t base, const auto& cols) {
                  for (std::size_t k = 0; k < cols[0].size(); ++k) {
-                   ar.run.ysim[base + k] = m.step(v1);
+                   const std::size_t row = base + k;
+                   while (next_gap < gap_rows.size() && gap_rows[next_gap] < row) ++next_gap;
+                   if (next_gap < gap_rows.size() && gap_rows[next_gap] == row && row > 0) {
+                     delay.reset();
+                     ar.run.ysim[row] = m.restart(std::isfinite(cols[1][k]) ? cols[1][k] : 0.0);
+                   } else {
+                     ar.run.ysim[row] = m.step(v1);
+                   }
                    v1 = delay.step(std::isfinite(cols[0][k]) ? cols[0][k] : 0.0);
                  }
                });

@@ -45,6 +45,12 @@ struct OutputErrorOptions {
   /// false: d_r, d_l stay at their start values (input-deadzone: 0, the model has no deadband);
   /// only a1, b1, c of each side are fitted and their half-widths of d are NaN.
   bool fit_d = true;
+  /// Rows (ascending) where the record restarts after a gap (the reader's gap rows): there the
+  /// free run's state is set from the measured y of that row (the plant is not at rest after a
+  /// gap) and the input's delay line empties, as at the record's start; the residuals of that row
+  /// and the `restart_settle` rows after it are not summed (the record's start gets `begin`).
+  std::span<const std::size_t> restart_rows;
+  std::size_t restart_settle = 0;
   /// Rows (ascending) whose y the fit reads from `edit_values` instead (the outlier gate's
   /// replacements, gate_outliers): an outlier would pull a least-squares fit.
   std::span<const std::size_t> edit_rows;
@@ -84,6 +90,9 @@ class FreeRunDzDb {
   FreeRunDzDb(const OutputErrorParams& th, bool by_sign, bool output_dz = false) noexcept;
   /// y_sim(k) given v(k − 1).
   double step(double v1) noexcept;
+  /// After a gap: the state that outputs y now (deadband: w = y_sim = y; output-deadzone: the
+  /// linear part's x beyond the edge on y's side, x = 0 for y = 0); returns y.
+  double restart(double y) noexcept;
 
  private:
   PerSide<double> edge_{};
@@ -107,7 +116,16 @@ struct OutputErrorReport {
   int starts = 0;              ///< fits run (refine_by_output_error's starts)
   int best_start = 0;          ///< the start whose fit was kept (0: the estimate)
   OutputErrorFit fit;          ///< the kept fit (passes: of all the starts)
+  /// output_error_check (output_error off): the fit from the estimate only checked it. Per side
+  /// (right, left): the parameter the fit moved furthest beyond the check's bounds (0–3: a1, b1,
+  /// c, d; −1: none, or the side was not identified) and by how much, |fit/estimate − 1| [-].
+  bool check = false;
+  std::array<int, 2> moved{-1, -1};
+  std::array<double, 2> moved_by{};
 };
+
+/// The names of θ's parameters of one side, by index 0–3: "a1", "b1", "c", "d".
+const char* side_param_name(int i) noexcept;
 
 struct AutoRun;
 struct EstimatorConfig;
@@ -130,9 +148,23 @@ void refuse_output_error_online(const EstimatorConfig& cfg, const char* where);
 /// 7–8 run on them. Not used (why_not says why): a side not_excited by the switching run's
 /// checks (its input held one level or one value), no side with finite parameters, a start the
 /// free run cannot hold, or a failed fit.
+/// With cfg.output_error_check instead (cfg.output_error off): the fit from the estimate only;
+/// the estimate, its free run and its intervals are kept, and an identified side whose a1, b1, c
+/// or d the fit moves by more than kCheckMove of its value and by more than kCheckHalfWidths of
+/// the fit's 95 % half-widths is reported poor_fit (the report's moved, moved_by), when the
+/// estimate's free-run sum of squares exceeds the fit's by more than kCheckCost.
 /// `gate`: the outlier gate's threshold of the run (AutoOptions::gate; 0 = off): the fit reads y
 /// with the gate's replacements, the NRMSE is taken against y as given.
+/// The output-error check's bounds (output_error_check): a move larger than both flags a side.
+inline constexpr double kCheckMove = 0.01;       ///< of the parameter's value [-]
+inline constexpr double kCheckHalfWidths = 3.0;  ///< of the fit's 95 % half-width [-]
+/// ... and only when the estimate's free-run sum of squares exceeds the fit's by more than this
+/// share of it (a move the output barely tells from the noise does not count) [-]
+inline constexpr double kCheckCost = 0.01;
+
+/// `gap_rows`: where the record restarts after a gap (OutputErrorOptions::restart_rows; the rows
+/// before `begin` are the settling allowance after each).
 void refine_by_output_error(AutoRun& run, const RecordColumns& record, std::size_t begin, std::size_t end,
-                            bool intervals, double gate);
+                            bool intervals, double gate, std::span<const std::size_t> gap_rows = {});
 
 }  // namespace lash
