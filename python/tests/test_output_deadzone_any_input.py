@@ -7,7 +7,9 @@ Measured before the output-deadzone model was refined by output error and took i
 from the noise (3 sigma): of 20 multisine runs, 4 identified a side, with b1 60-89 % and c 90-98 %
 off (every noise sample above 0 inside the deadzone was a right-side update, and the regressor
 y(k-1) is noisy). After: every side of every run identified, a1, b1, c within 0.4 %; 114 of the
-120 95 % intervals hold the truth. Noise-free: the plant to 4e-6."""
+120 95 % intervals hold the truth. Noise-free: the plant to 4e-6. In closed loop (a PI controller on a
+random reference) every side within 0.33 %; on a PRBS each side is within 0.34 % or not
+identified."""
 import math
 
 import numpy as np
@@ -17,12 +19,17 @@ import lash
 DT = 0.005
 
 
-def case(seed, kind):
+def plant(seed):
+    """seed's random plant: tau 0.05..0.5 s, K 0.5..3, edges 80..300 (output unit); and the
+    generator the input and the noise are drawn from after it"""
     rng = np.random.default_rng([seed, 7])
     tau, k = rng.uniform(0.05, 0.5), rng.uniform(0.5, 3.0)
     a1 = -math.exp(-DT / tau)
-    b1 = k * (1 + a1)
-    cr, cl = rng.uniform(80, 300), -rng.uniform(80, 300)  # output unit
+    return rng, tau, k, a1, k * (1 + a1), rng.uniform(80, 300), -rng.uniform(80, 300)
+
+
+def case(seed, kind):
+    rng, tau, k, a1, b1, cr, cl = plant(seed)
     n = 30000
     t = np.arange(n) * DT
     if kind == "multisine":
@@ -61,6 +68,81 @@ def test_output_deadzone_identifies_from_multisines_and_steps_with_noise():
     assert worst["a1"] <= 0.01 and worst["b1"] <= 0.03 and worst["c"] <= 0.03, worst
     # the 95 % intervals hold the truth at least 90 % of the time
     assert covered >= 0.90 * intervals, (covered, intervals)
+
+
+def closed_loop(seed, noise=True):
+    """The same random plants under a PI controller (kp = 0.3/K, ki = kp/tau, the input clamped
+    to 4 max|c|/K) tracking a random reference (levels in +-1.5 max|c|, held 1 s): the noise is
+    in the loop (the controller reads y + e), sigma = 1.4 % of 2.5 max|c|."""
+    rng, tau, k, a1, b1, cr, cl = plant(seed)
+    n = 30000
+    e_n = rng.normal(0.0, 0.014 * 2.5 * max(cr, -cl), n) if noise else np.zeros(n)
+    ref = np.repeat(rng.uniform(-1.5, 1.5, n // 200 + 1), 200)[:n] * max(cr, -cl)
+    kp, ki, vmax = 0.3 / k, 0.3 / (k * tau), 4.0 * max(cr, -cl) / k
+    v, y = np.zeros(n), np.zeros(n)
+    x = integ = 0.0
+    for i in range(n):
+        y0 = 0.0
+        if i > 0:
+            x = -a1 * x + b1 * v[i - 1]
+            y0 = x - cr if x > cr else (x - cl if x < cl else 0.0)
+        y[i] = y0 + e_n[i]
+        integ += (ref[i] - y[i]) * DT
+        v[i] = max(-vmax, min(vmax, kp * (ref[i] - y[i]) + ki * integ))
+    return np.arange(n) * DT, v, y, dict(a1=a1, b1=b1, right=cr, left=cl)
+
+
+def test_output_deadzone_identifies_in_closed_loop():
+    # issue 30's closed-loop operating data: the output-error fit is consistent in closed loop for
+    # a strictly proper plant (docs/method.md A4.4c, the direct approach). Measured: every side of
+    # the 10 seeds identified, a1 within 0.014 %, b1 0.33 %, c 0.33 %; noise-free the plant
+    worst = {"a1": 0.0, "b1": 0.0, "c": 0.0}
+    for seed in range(1, 11):
+        t, v, y, p = closed_loop(seed)
+        r = lash.estimate(t, v, y, model="output-deadzone").to_dict()
+        assert r["output_error"]["used"], (seed, r["output_error"])
+        for side in ("right", "left"):
+            j = r[side]
+            assert j["identified"], (seed, side, j["reason"])
+            for key, want in (("a1", p["a1"]), ("b1", p["b1"]), ("c", p[side])):
+                worst[key] = max(worst[key], abs(j[key] / want - 1.0))
+    print(worst)
+    assert worst["a1"] <= 0.01 and worst["b1"] <= 0.03 and worst["c"] <= 0.03, worst
+    t, v, y, p = closed_loop(1, noise=False)
+    r = lash.estimate(t, v, y, model="output-deadzone").to_dict()
+    for side in ("right", "left"):
+        for key, want in (("a1", p["a1"]), ("b1", p["b1"]), ("c", p[side])):
+            assert abs(r[side][key] / want - 1.0) < 1e-4, (side, key, r[side][key], want)
+
+
+def test_output_deadzone_on_a_prbs_is_right_or_not_identified():
+    # a two-level input (+-2.5 max|c|/K, each level held 0.3 s): a side whose updates sit at its
+    # own level is not_excited (b1 and c are one sum there); where the output passes a side while
+    # the input has switched, the side sees both levels and is identified. Measured with noise:
+    # seeds 3, 4, 5, 9, 10 both sides within 0.34 %; 2, 6, 7, 8 both not_excited; seed 1 right
+    # not_excited and left poor_fit: the refinement cannot run with a side unexcited, so its fit
+    # checks the other side (docs/method.md A4.4c) and moves c by 43 % (before the check: left
+    # identified with c 43 % off)
+    identified = 0
+    for seed in range(1, 11):
+        rng, tau, k, a1, b1, cr, cl = plant(seed)
+        n = 30000
+        e_n = rng.normal(0.0, 0.014 * 2.5 * max(cr, -cl), n)
+        v = np.repeat(np.where(rng.random(n // 60 + 1) < 0.5, -1.0, 1.0), 60)[:n] * 2.5 * max(cr, -cl) / k
+        x, y = 0.0, np.zeros(n)
+        for i in range(1, n):
+            x = -a1 * x + b1 * v[i - 1]
+            y[i] = x - cr if x > cr else (x - cl if x < cl else 0.0)
+        r = lash.estimate(np.arange(n) * DT, v, y + e_n, model="output-deadzone").to_dict()
+        for side, c in (("right", cr), ("left", cl)):
+            j = r[side]
+            if not j["identified"]:
+                assert j["reason"] in ("not_excited", "poor_fit"), (seed, side, j["reason"])
+                continue
+            identified += 1
+            for key, want in (("a1", a1), ("b1", b1), ("c", c)):
+                assert abs(j[key] / want - 1.0) <= 0.03, (seed, side, key, j[key], want)
+    assert identified >= 10, identified
 
 
 def test_output_deadzone_noise_free_is_the_plant():

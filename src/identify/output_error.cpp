@@ -293,18 +293,24 @@ SideIntervals fit_intervals(const OutputErrorFit& f, Side side, double dt_s) {
   return ci;
 }
 
-/// output_error_check: the estimate stays; an identified side the fit (out.fit, from the
-/// estimate) moves beyond both bounds in any of its parameters is reported poor_fit.
-void check_estimate(AutoRun& ar, bool has_d) {
+/// output_error_check (or a side not_excited): the estimate stays; an identified side the fit
+/// of lowest cost (out.fit, from the estimate and the further starts) moves beyond the bounds in
+/// any of its parameters is reported poor_fit.
+void check_estimate(AutoRun& ar, bool has_d, bool unexcited) {
   OutputErrorReport& out = ar.output_error;
   out.check = true;
   const OutputErrorFit& f = out.fit;
+  out.why_not = unexcited ? "a side is not excited (its input held one level or one value): the fit only checks the "
+                            "other side's estimate"
+                          : "check only (output-error-check): the switching estimate is kept";
   if (!f.ok) {
     out.why_not = "check: the fit failed (too few rows in the window, or a non-finite pass)";
     return;
   }
-  out.why_not = "check only (output-error-check): the switching estimate is kept";
   if (!(f.rms_start * f.rms_start > (1.0 + kCheckCost) * f.rms * f.rms)) return;  // no material gain
+  // a free run more than twice the fit's sum of squares is the estimate's bias whatever the
+  // fit's intervals (wide where the fit itself misfits)
+  const bool gross = f.rms_start * f.rms_start > (1.0 + kCheckGross) * f.rms * f.rms;
   EstimateReport& rep = ar.run.report;
   for (const Side s : {Side::right, Side::left}) {
     SideParams& p = rep[s].params;
@@ -316,7 +322,7 @@ void check_estimate(AutoRun& ar, bool has_d) {
       const double diff = std::fabs(f.theta[b + i] - est[i]);
       const double hw = std::isfinite(f.half95[b + i]) ? f.half95[b + i] : 0.0;
       const double by = est[i] != 0.0 ? diff / std::fabs(est[i]) : kInf;
-      if (diff > std::max(kCheckMove * std::fabs(est[i]), kCheckHalfWidths * hw) && by > out.moved_by[si]) {
+      if (diff > kCheckMove * std::fabs(est[i]) && (gross || diff > kCheckHalfWidths * hw) && by > out.moved_by[si]) {
         out.moved[si] = static_cast<int>(i);
         out.moved_by[si] = by;
       }
@@ -361,14 +367,14 @@ void refine_by_output_error(AutoRun& ar, const RecordColumns& rec, std::size_t b
   const auto finite = [has_d](const SideParams& p) {
     return std::isfinite(p.a1) && std::isfinite(p.b1) && std::isfinite(p.c) && (!has_d || std::isfinite(p.d));
   };
+  // Such a side leaves the refinement to a check of the other side (check_estimate): the fit
+  // from the estimates, the unexcited side from its own values where it has them.
+  bool unexcited = false;
   OutputErrorParams start{};
   for (const Side s : {Side::right, Side::left}) {
     const SideParams& p = rep[s].params;
     const SideParams& q = rep[s == Side::right ? Side::left : Side::right].params;
-    if (p.reason == Reason::not_excited) {
-      out.why_not = "a side is not excited (its input held one level or one value)";
-      return;
-    }
+    unexcited = unexcited || p.reason == Reason::not_excited;
     if (finite(p)) put(start, s, p);
     else if (finite(q)) {
       SideParams mirrored = q;
@@ -378,6 +384,10 @@ void refine_by_output_error(AutoRun& ar, const RecordColumns& rec, std::size_t b
       out.why_not = "neither side has an estimate to start from";
       return;
     }
+  }
+  if (unexcited && !rep[Side::right].params.identified && !rep[Side::left].params.identified) {
+    out.why_not = "a side is not excited (its input held one level or one value)";
+    return;  // nothing to refine, nothing to check
   }
   OutputErrorOptions o;
   o.begin = begin;
@@ -404,10 +414,6 @@ void refine_by_output_error(AutoRun& ar, const RecordColumns& rec, std::size_t b
   // kWhite (a white measurement noise gives |ρ1| ~ 1/√n), or no convergence in max_passes.
   out.fit = fit_output_error(rec, start, o);
   out.starts = 1;
-  if (!cfg.output_error) {
-    check_estimate(ar, has_d);
-    return;
-  }
   std::vector<OutputErrorParams> starts;
   const OutputErrorParams first = out.fit.theta;
   const auto lend = [&](std::size_t from, std::size_t to) {
@@ -444,6 +450,10 @@ void refine_by_output_error(AutoRun& ar, const RecordColumns& rec, std::size_t b
         out.fit.passes += g.passes;
       }
     }
+  if (!cfg.output_error || unexcited) {  // the fit of lowest cost only checks the estimate
+    check_estimate(ar, has_d, unexcited);
+    return;
+  }
   const OutputErrorFit& f = out.fit;
   if (!f.ok) {
     out.why_not = admissible(start) ? "the fit failed (too few rows in the window, or a non-finite pass)"

@@ -146,13 +146,15 @@ void refuse_output_error_online(const EstimatorConfig& cfg, const char* where);
 /// values, check 2 on the fit's information (a side whose JᵀJ block is singular is
 /// not_excited). With `intervals`, the fit's 95 % intervals replace the batch means' and checks
 /// 7–8 run on them. Not used (why_not says why): a side not_excited by the switching run's
-/// checks (its input held one level or one value), no side with finite parameters, a start the
+/// checks (its input held one level or one value; then the check below), no side with finite parameters, a start the
 /// free run cannot hold, or a failed fit.
-/// With cfg.output_error_check instead (cfg.output_error off): the fit from the estimate only;
-/// the estimate, its free run and its intervals are kept, and an identified side whose a1, b1, c
+/// With cfg.output_error_check instead (cfg.output_error off), or with a side not_excited: the
+/// same fits (the further starts too) only check the estimate; it, its free run and its
+/// intervals are kept, and an identified side whose a1, b1, c
 /// or d the fit moves by more than kCheckMove of its value and by more than kCheckHalfWidths of
 /// the fit's 95 % half-widths is reported poor_fit (the report's moved, moved_by), when the
-/// estimate's free-run sum of squares exceeds the fit's by more than kCheckCost.
+/// estimate's free-run sum of squares exceeds the fit's by more than kCheckCost (by more than
+/// kCheckGross: the half-widths' bound waived).
 /// `gate`: the outlier gate's threshold of the run (AutoOptions::gate; 0 = off): the fit reads y
 /// with the gate's replacements, the NRMSE is taken against y as given.
 /// The output-error check's bounds (output_error_check): a move larger than both flags a side.
@@ -161,6 +163,9 @@ inline constexpr double kCheckHalfWidths = 3.0;  ///< of the fit's 95 % half-wid
 /// ... and only when the estimate's free-run sum of squares exceeds the fit's by more than this
 /// share of it (a move the output barely tells from the noise does not count) [-]
 inline constexpr double kCheckCost = 0.01;
+/// ... and the half-widths' bound is waived when it exceeds the fit's by more than this share
+/// (the fit misfits too, its intervals are wide, but the estimate is the further off) [-]
+inline constexpr double kCheckGross = 1.0;
 
 /// `gap_rows`: where the record restarts after a gap (OutputErrorOptions::restart_rows; the rows
 /// before `begin` are the settling allowance after each).
