@@ -170,12 +170,13 @@ struct DeadzoneDeadbandSettings {
   /// (Levenberg–Marquardt, identify/output_error.hpp) and judge and bound the result. Offline
   /// only (whole-record passes); the online estimator refuses it.
   bool output_error = false;
-  /// Output-error check (docs/method.md §A4.4c; same models): with output_error off, the same fit
-  /// from the estimate only checks it. The estimate is kept; a side the fit moves by more than
-  /// 1 % and by more than three of the fit's 95 % half-widths in a1, b1, c or d (the
-  /// estimate is not the least-squares fit of the output the model can reach from it) is
-  /// reported poor_fit. On in the thesis preset of the deadzone-deadband (it has no refinement);
-  /// offline only: the estimators fed sample by sample do not run it.
+  /// Output-error check (docs/method.md §A4.4c; same models): with output_error off, the same fits
+  /// from the estimate only check it. The estimate is kept; a side the fit moves by more than
+  /// 1 % in a1, b1, c or d, beyond three of the fit's 95 % half-widths, where the estimate's
+  /// free run misfits by more than 1 % (the bounds: kCheck* in output_error.hpp), is not the
+  /// least-squares fit of the output the model reaches from it and is reported poor_fit. On in
+  /// the thesis preset of the deadzone-deadband (it has no refinement); the refinement checks so
+  /// too when a side is not_excited. Offline only: estimators fed sample by sample do not run it.
   bool output_error_check = false;
   /// Model switching: the model's deadband must have been engaged in one direction, with v on
   /// one side of zero, for this many samples in a row before a sample updates [samples].
