@@ -58,6 +58,22 @@ bool admissible(const OutputErrorParams& t) noexcept {
          t[6] <= 0.0 && t[3] >= 0.0 && t[7] >= 0.0;
 }
 
+/// Walks an ascending list of rows alongside a pass over the record (rows asked in ascending
+/// order): at(row) is the list's index of `row`, or npos when it is not listed.
+class RowCursor {
+ public:
+  static constexpr std::size_t npos = static_cast<std::size_t>(-1);
+  explicit RowCursor(std::span<const std::size_t> rows) noexcept : rows_(rows) {}
+  std::size_t at(std::size_t row) noexcept {
+    while (i_ < rows_.size() && rows_[i_] < row) ++i_;
+    return i_ < rows_.size() && rows_[i_] == row ? i_ : npos;
+  }
+
+ private:
+  std::span<const std::size_t> rows_;
+  std::size_t i_ = 0;
+};
+
 /// One pass: rᵀr, JᵀJ and Jᵀr at θ (J by forward differences of step h).
 struct Pass {
   double sse = 0.0;
@@ -87,18 +103,17 @@ Pass run_pass(const RecordColumns& rec, const OutputErrorParams& th, const Outpu
   Pass p;
   double v1 = 0.0, r_prev = 0.0;
   bool have_prev = false;
-  std::size_t next_edit = 0, next_gap = 0, settled = o.begin;
+  RowCursor edits(o.edit_rows), gaps(o.restart_rows);
+  std::size_t settled = o.begin;
   Delay delay(o.dead_time);  // v(k − dead_time), 0 before the record
   for_chunks(rec.store, rec.vy, 0, end, [&](std::size_t base, const auto& cols) {
     const auto& v = cols[0];
     const auto& y = cols[1];
     for (std::size_t k = 0; k < v.size(); ++k) {
       const std::size_t row = base + k;
-      while (next_edit < o.edit_rows.size() && o.edit_rows[next_edit] < row) ++next_edit;
-      const bool edited = next_edit < o.edit_rows.size() && o.edit_rows[next_edit] == row;
-      const double yk = edited ? o.edit_values[next_edit] : y[k];
-      while (next_gap < o.restart_rows.size() && o.restart_rows[next_gap] < row) ++next_gap;
-      const bool gap = next_gap < o.restart_rows.size() && o.restart_rows[next_gap] == row && row > 0;
+      const std::size_t edit = edits.at(row);
+      const double yk = edit != RowCursor::npos ? o.edit_values[edit] : y[k];
+      const bool gap = gaps.at(row) != RowCursor::npos && row > 0;
       std::array<double, P + 1> ys{};
       if (gap) {  // the plant is where y says, its input history unknown: as at the record's start
         delay.reset();
@@ -494,13 +509,12 @@ void refine_by_output_error(AutoRun& ar, const RecordColumns& rec, std::size_t b
     FreeRunDzDb m(f.theta, o.side_by_sign, o.output_deadzone);  // the rule the fit used
     Delay delay(o.dead_time);
     double v1 = 0.0;
-    std::size_t next_gap = 0;
+    RowCursor gaps(gap_rows);
     for_chunks(rec.store, rec.vy, 0, std::min(rec.size(), ar.run.ysim.size()),
                [&](std::size_t base, const auto& cols) {
                  for (std::size_t k = 0; k < cols[0].size(); ++k) {
                    const std::size_t row = base + k;
-                   while (next_gap < gap_rows.size() && gap_rows[next_gap] < row) ++next_gap;
-                   if (next_gap < gap_rows.size() && gap_rows[next_gap] == row && row > 0) {
+                   if (gaps.at(row) != RowCursor::npos && row > 0) {
                      delay.reset();
                      ar.run.ysim[row] = m.restart(std::isfinite(cols[1][k]) ? cols[1][k] : 0.0);
                    } else {
