@@ -15,6 +15,7 @@ import math
 import numpy as np
 
 import lash
+from conftest import run_lash
 
 DT = 0.005
 
@@ -115,7 +116,7 @@ def test_output_deadzone_identifies_in_closed_loop():
             assert abs(r[side][key] / want - 1.0) < 1e-4, (side, key, r[side][key], want)
 
 
-def test_output_deadzone_on_a_prbs_is_right_or_not_identified():
+def test_output_deadzone_on_a_prbs_is_right_or_not_identified(tmp_path):
     # a two-level input (+-2.5 max|c|/K, each level held 0.3 s): a side whose updates sit at its
     # own level is not_excited (b1 and c are one sum there); where the output passes a side while
     # the input has switched, the side sees both levels and is identified. Measured with noise:
@@ -134,6 +135,17 @@ def test_output_deadzone_on_a_prbs_is_right_or_not_identified():
             x = -a1 * x + b1 * v[i - 1]
             y[i] = x - cr if x > cr else (x - cl if x < cl else 0.0)
         r = lash.estimate(np.arange(n) * DT, v, y + e_n, model="output-deadzone").to_dict()
+        if seed == 1:
+            # the CLI's text names the flagged side and what to do: lash's preset already tried
+            # the refinement, so the advice is the input's, not "use lash's preset"
+            path = tmp_path / "prbs.csv"
+            np.savetxt(path, np.column_stack([np.arange(n) * DT, v, y + e_n]), delimiter=",", header="t,v,y",
+                       comments="")
+            out = run_lash("estimate", path, "--model", "output-deadzone")
+            assert r["output_error"]["check"]["left"]["moved"] == "c", r["output_error"]
+            line = [x for x in out.splitlines() if x.startswith("output error check:")]
+            assert len(line) == 1 and "left side's c by" in line[0], out
+            assert "drive beyond both edges" in line[0] and "use lash's preset" not in line[0], line
         for side, c in (("right", cr), ("left", cl)):
             j = r[side]
             if not j["identified"]:

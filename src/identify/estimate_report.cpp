@@ -360,11 +360,16 @@ std::string estimate_auto_text(const AutoRun& ar, double dt_s, const ReportFit& 
                                  oe.fit.converged ? "converged" : "did not converge", oe.fit.passes, oe.fit.steps,
                                  oe.fit.rms_start, oe.fit.rms)
                    : fmt::format("output error: not used ({})\n", oe.why_not);
+    // The advice: with the refinement off (the thesis preset) it is to turn it on; with it on, it
+    // did not run because the other side is not_excited, so the input is what to change.
+    const char* advice = ar.cfg.output_error
+                             ? "the refinement needs both sides excited: drive beyond both edges, in both directions"
+                             : "use lash's preset, or --output-error, for the refined estimate";
     for (const auto& [name, i] : {std::pair{"right", 0}, std::pair{"left", 1}})
       if (oe.check && oe.moved[i] >= 0)
         out += fmt::format("output error check: the fit from this estimate moves the {} side's {} by {:.3g} %: "
-                           "reported poor_fit (use lash's preset, or --output-error, for the refined estimate)\n",
-                           name, side_param_name(oe.moved[i]), 100.0 * oe.moved_by[i]);
+                           "reported poor_fit ({})\n",
+                           name, side_param_name(oe.moved[i]), 100.0 * oe.moved_by[i], advice);
   }
   return out;
 }
