@@ -321,9 +321,10 @@ std::string estimate_auto_json(const AutoRun& ar, Preset preset, const ReportFit
       o["why_not"] = oe.why_not;
     if (oe.check) {  // output_error_check: what the fit from the estimate moved
       Json c{{"rms_start", num(oe.fit.rms_start)}, {"rms", num(oe.fit.rms)}, {"passes", oe.fit.passes}};
-      for (const auto& [name, i] : {std::pair{"right", 0}, std::pair{"left", 1}})
-        c[name] = oe.moved[i] < 0 ? Json(nullptr)
-                                  : Json{{"moved", side_param_name(oe.moved[i])}, {"by", num(oe.moved_by[i])}};
+      for (const Side s : {Side::right, Side::left})
+        c[to_string(s)] = oe.moved[s].param < 0
+                              ? Json(nullptr)
+                              : Json{{"moved", side_param_name(oe.moved[s].param)}, {"by", num(oe.moved[s].by)}};
       o["check"] = c;
     }
     j["output_error"] = o;
@@ -365,11 +366,11 @@ std::string estimate_auto_text(const AutoRun& ar, double dt_s, const ReportFit& 
     const char* advice = ar.cfg.output_error
                              ? "the refinement needs both sides excited: drive beyond both edges, in both directions"
                              : "use lash's preset, or --output-error, for the refined estimate";
-    for (const auto& [name, i] : {std::pair{"right", 0}, std::pair{"left", 1}})
-      if (oe.check && oe.moved[i] >= 0)
+    for (const Side s : {Side::right, Side::left})
+      if (oe.check && oe.moved[s].param >= 0)
         out += fmt::format("output error check: the fit from this estimate moves the {} side's {} by {:.3g} %: "
                            "reported poor_fit ({})\n",
-                           name, side_param_name(oe.moved[i]), 100.0 * oe.moved_by[i], advice);
+                           to_string(s), side_param_name(oe.moved[s].param), 100.0 * oe.moved[s].by, advice);
   }
   return out;
 }

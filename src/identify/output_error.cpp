@@ -332,17 +332,17 @@ void check_estimate(AutoRun& ar, bool has_d, bool unexcited) {
     if (!p.identified) continue;
     const std::size_t b = offset(s);
     const std::array<double, 4> est{p.a1, p.b1, p.c, p.d};
-    const std::size_t si = s == Side::right ? 0 : 1;
+    OutputErrorReport::CheckMove& m = out.moved[s];
     for (std::size_t i = 0; i < (has_d ? 4u : 3u); ++i) {
       const double diff = std::fabs(f.theta[b + i] - est[i]);
       const double hw = std::isfinite(f.half95[b + i]) ? f.half95[b + i] : 0.0;
       const double by = est[i] != 0.0 ? diff / std::fabs(est[i]) : kInf;
-      if (diff > kCheckMove * std::fabs(est[i]) && (gross || diff > kCheckHalfWidths * hw) && by > out.moved_by[si]) {
-        out.moved[si] = static_cast<int>(i);
-        out.moved_by[si] = by;
+      if (diff > kCheckMove * std::fabs(est[i]) && (gross || diff > kCheckHalfWidths * hw) && by > m.by) {
+        m.param = static_cast<int>(i);
+        m.by = by;
       }
     }
-    if (out.moved[si] >= 0) {
+    if (m.param >= 0) {
       p.identified = false;
       p.reason = Reason::poor_fit;
       rep.identified = false;

@@ -23,6 +23,7 @@
 #include <cstdint>
 #include <span>
 
+#include "lash/blocks/side.hpp"
 #include "lash/identify/estimator_skeleton.hpp"
 #include "lash/identify/record_columns.hpp"
 
@@ -116,12 +117,16 @@ struct OutputErrorReport {
   int starts = 0;              ///< fits run (refine_by_output_error's starts)
   int best_start = 0;          ///< the start whose fit was kept (0: the estimate)
   OutputErrorFit fit;          ///< the kept fit (passes: of all the starts)
-  /// output_error_check (output_error off): the fit from the estimate only checked it. Per side
-  /// (right, left): the parameter the fit moved furthest beyond the check's bounds (0–3: a1, b1,
-  /// c, d; −1: none, or the side was not identified) and by how much, |fit/estimate − 1| [-].
+  /// output_error_check (output_error off, or on with a side not_excited): the fit from the
+  /// estimate only checked it; per side, what it moved (CheckMove).
   bool check = false;
-  std::array<int, 2> moved{-1, -1};
-  std::array<double, 2> moved_by{};
+  /// The parameter the fit moved furthest beyond the check's bounds (0–3: a1, b1, c, d; −1: none,
+  /// or the side was not identified) and by how much, |fit/estimate − 1| [-].
+  struct CheckMove {
+    int param = -1;
+    double by = 0.0;
+  };
+  PerSide<CheckMove> moved;
 };
 
 /// The names of θ's parameters of one side, by index 0–3: "a1", "b1", "c", "d".
@@ -152,7 +157,7 @@ void refuse_output_error_online(const EstimatorConfig& cfg, const char* where);
 /// same fits (the further starts too) only check the estimate; it, its free run and its
 /// intervals are kept, and an identified side whose a1, b1, c
 /// or d the fit moves by more than kCheckMove of its value and by more than kCheckHalfWidths of
-/// the fit's 95 % half-widths is reported poor_fit (the report's moved, moved_by), when the
+/// the fit's 95 % half-widths is reported poor_fit (the report's moved), when the
 /// estimate's free-run sum of squares exceeds the fit's by more than kCheckCost (by more than
 /// kCheckGross: the half-widths' bound waived).
 /// `gate`: the outlier gate's threshold of the run (AutoOptions::gate; 0 = off): the fit reads y
