@@ -74,6 +74,29 @@ class RowCursor {
   std::size_t i_ = 0;
 };
 
+/// What drives the free runs of a pass: v(k − 1 − dead_time), a missing input as 0 (it drives
+/// nothing), and the gap rows, where the plant is where y says and its input history is unknown
+/// (as at the record's start): the delay empties and the runs restart from y, a missing y as 0.
+class Drive {
+ public:
+  Drive(std::size_t dead_time, std::span<const std::size_t> gap_rows) noexcept : delay_(dead_time), gaps_(gap_rows) {}
+  /// Whether `row` (asked in ascending order) restarts the runs; empties the delay if so.
+  bool restarts(std::size_t row) noexcept {
+    const bool gap = gaps_.at(row) != RowCursor::npos && row > 0;
+    if (gap) delay_.reset();
+    return gap;
+  }
+  static double restart_value(double y) noexcept { return std::isfinite(y) ? y : 0.0; }
+  double v1() const noexcept { return v1_; }
+  /// After the row's step: its input enters the delay.
+  void push(double v) noexcept { v1_ = delay_.step(std::isfinite(v) ? v : 0.0); }
+
+ private:
+  Delay delay_;
+  RowCursor gaps_;
+  double v1_ = 0.0;
+};
+
 /// One pass: rᵀr, JᵀJ and Jᵀr at θ (J by forward differences of step h).
 struct Pass {
   double sse = 0.0;
@@ -101,11 +124,11 @@ Pass run_pass(const RecordColumns& rec, const OutputErrorParams& th, const Outpu
               const OutputErrorOptions& o, std::size_t end) {
   auto m = perturbed(th, h, o.side_by_sign, o.output_deadzone, std::make_index_sequence<P + 1>{});
   Pass p;
-  double v1 = 0.0, r_prev = 0.0;
+  double r_prev = 0.0;
   bool have_prev = false;
-  RowCursor edits(o.edit_rows), gaps(o.restart_rows);
+  RowCursor edits(o.edit_rows);
+  Drive drive(o.dead_time, o.restart_rows);
   std::size_t settled = o.begin;
-  Delay delay(o.dead_time);  // v(k − dead_time), 0 before the record
   for_chunks(rec.store, rec.vy, 0, end, [&](std::size_t base, const auto& cols) {
     const auto& v = cols[0];
     const auto& y = cols[1];
@@ -113,16 +136,13 @@ Pass run_pass(const RecordColumns& rec, const OutputErrorParams& th, const Outpu
       const std::size_t row = base + k;
       const std::size_t edit = edits.at(row);
       const double yk = edit != RowCursor::npos ? o.edit_values[edit] : y[k];
-      const bool gap = gaps.at(row) != RowCursor::npos && row > 0;
+      const bool gap = drive.restarts(row);
       std::array<double, P + 1> ys{};
-      if (gap) {  // the plant is where y says, its input history unknown: as at the record's start
-        delay.reset();
-        settled = std::max(settled, row + 1 + o.restart_settle);
-      }
+      if (gap) settled = std::max(settled, row + 1 + o.restart_settle);
       for (std::size_t i = 0; i <= P; ++i)
         if (o.fit_d || (i != 4 && i != 8))  // d held: its points are not run
-          ys[i] = gap ? m[i].restart(std::isfinite(yk) ? yk : 0.0) : m[i].step(v1);
-      v1 = delay.step(std::isfinite(v[k]) ? v[k] : 0.0);  // a missing input drives nothing
+          ys[i] = gap ? m[i].restart(Drive::restart_value(yk)) : m[i].step(drive.v1());
+      drive.push(v[k]);
       if (row < settled || !std::isfinite(y[k]) || !std::isfinite(v[k])) {
         have_prev = false;
         continue;
@@ -507,20 +527,14 @@ void refine_by_output_error(AutoRun& ar, const RecordColumns& rec, std::size_t b
                      cfg.ci_tolerance);
   if (!ar.run.ysim.empty()) {  // the stored free run: the refined model's
     FreeRunDzDb m(f.theta, o.side_by_sign, o.output_deadzone);  // the rule the fit used
-    Delay delay(o.dead_time);
-    double v1 = 0.0;
-    RowCursor gaps(gap_rows);
+    Drive drive(o.dead_time, gap_rows);
     for_chunks(rec.store, rec.vy, 0, std::min(rec.size(), ar.run.ysim.size()),
                [&](std::size_t base, const auto& cols) {
                  for (std::size_t k = 0; k < cols[0].size(); ++k) {
                    const std::size_t row = base + k;
-                   if (gaps.at(row) != RowCursor::npos && row > 0) {
-                     delay.reset();
-                     ar.run.ysim[row] = m.restart(std::isfinite(cols[1][k]) ? cols[1][k] : 0.0);
-                   } else {
-                     ar.run.ysim[row] = m.step(v1);
-                   }
-                   v1 = delay.step(std::isfinite(cols[0][k]) ? cols[0][k] : 0.0);
+                   ar.run.ysim[row] =
+                       drive.restarts(row) ? m.restart(Drive::restart_value(cols[1][k])) : m.step(drive.v1());
+                   drive.push(cols[0][k]);
                  }
                });
   }
