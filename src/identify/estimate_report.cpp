@@ -327,6 +327,15 @@ std::string estimate_auto_json(const AutoRun& ar, Preset preset, const ReportFit
                               : Json{{"moved", side_param_name(oe.moved[s].param)}, {"by", num(oe.moved[s].by)}};
       o["check"] = c;
     }
+    if (const auto& db = oe.deadband; db.tried) {  // input-deadzone: the same fit with d free
+      Json c{{"ok", db.ok}, {"flagged", db.flagged}, {"passes", db.passes}};
+      if (db.ok) {
+        c["rms"] = num(db.rms);
+        for (const Side s : {Side::right, Side::left})
+          c[to_string(s)] = {{"d", num(db.d[s])}, {"d_half95", num(db.d_half95[s])}};
+      }
+      o["deadband_check"] = c;
+    }
     j["output_error"] = o;
   }
   j["preset"] = to_string(preset);
@@ -371,6 +380,11 @@ std::string estimate_auto_text(const AutoRun& ar, double dt_s, const ReportFit& 
         out += fmt::format("output error check: the fit from this estimate moves the {} side's {} by {:.3g} %: "
                            "reported poor_fit ({})\n",
                            to_string(s), side_param_name(oe.moved[s].param), 100.0 * oe.moved[s].by, advice);
+    if (const auto& db = oe.deadband; db.flagged)
+      out += fmt::format("deadband check: a deadband of d_r = {:.6g}, d_l = {:.6g} lowers the free-run rms {:.6g} -> "
+                         "{:.6g}: the record shows a backlash this model lacks, both sides reported poor_fit; use "
+                         "--model deadzone-deadband\n",
+                         db.d[Side::right], db.d[Side::left], oe.fit.rms, db.rms);
   }
   return out;
 }

@@ -369,6 +369,38 @@ void check_estimate(AutoRun& ar, bool has_d, bool unexcited) {
     }
   }
 }
+/// The deadband check (OutputErrorReport::DeadbandCheck) of a used input-deadzone refinement:
+/// the fit again from its result with d free, started at kDeadbandStart of the peak |y| on
+/// each side (d = 0 is the boundary of the constraint d >= 0).
+void check_deadband(AutoRun& ar, const RecordColumns& rec, OutputErrorOptions o) {
+  OutputErrorReport& out = ar.output_error;
+  OutputErrorReport::DeadbandCheck& db = out.deadband;
+  db.tried = true;
+  OutputErrorParams start = out.fit.theta;
+  start[3] = start[7] = kDeadbandStart * out.fit.y_peak;
+  o.fit_d = true;
+  const OutputErrorFit g = fit_output_error(rec, start, o);
+  db.passes = g.passes;
+  if (!g.ok) return;
+  db.ok = true;
+  db.rms = g.rms;
+  bool clear = false;  // a side's d with its 95 % interval clear of 0
+  for (const Side s : {Side::right, Side::left}) {
+    const std::size_t i = offset(s) + 3;
+    db.d[s] = g.theta[i];
+    db.d_half95[s] = g.half95[i];
+    clear = clear || (std::isfinite(g.half95[i]) && g.theta[i] > g.half95[i]);
+  }
+  if (!(clear && g.rms * g.rms < (1.0 - kDeadbandGain) * out.fit.rms * out.fit.rms)) return;
+  db.flagged = true;
+  EstimateReport& rep = ar.run.report;
+  for (const Side s : {Side::right, Side::left})
+    if (rep[s].params.identified) {
+      rep[s].params.identified = false;
+      rep[s].params.reason = Reason::poor_fit;
+    }
+  rep.identified = false;
+}
 }  // namespace
 
 const char* side_param_name(int i) noexcept {
@@ -525,6 +557,7 @@ void refine_by_output_error(AutoRun& ar, const RecordColumns& rec, std::size_t b
   if (intervals)
     attach_intervals(rep, {fit_intervals(f, Side::right, cfg.dt_s), fit_intervals(f, Side::left, cfg.dt_s)},
                      cfg.ci_tolerance);
+  if (cfg.model == ModelKind::input_deadzone) check_deadband(ar, rec, o);
   if (!ar.run.ysim.empty()) {  // the stored free run: the refined model's
     FreeRunDzDb m(f.theta, o.side_by_sign, o.output_deadzone);  // the rule the fit used
     Drive drive(o.dead_time, gap_rows);

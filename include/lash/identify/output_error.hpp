@@ -127,7 +127,29 @@ struct OutputErrorReport {
     double by = 0.0;
   };
   PerSide<CheckMove> moved;
+  /// The deadband check of an input-deadzone refinement (docs/method.md §A4.4c): the model nests
+  /// in deadzone-deadband (d = 0), so the same fit is run once more from its result with d free.
+  /// A deadband that lowers the free run's sum of squares by more than kDeadbandGain, with the
+  /// 95 % interval of a side's d clear of 0, is a backlash the record shows and this model lacks:
+  /// its a1, b1 and c absorb it (biased), and both sides are reported poor_fit.
+  struct DeadbandCheck {
+    bool tried = false;       ///< the refinement was used on an input-deadzone model
+    bool ok = false;          ///< the fit with d free ran (finite)
+    bool flagged = false;     ///< the sides were reported poor_fit for it
+    int passes = 0;           ///< its passes over the record
+    double rms = 0.0;         ///< free-run rms with d free [y unit] (against fit.rms)
+    PerSide<double> d{};      ///< the deadband half-widths it found [y unit]
+    PerSide<double> d_half95{};  ///< their 95 % half-widths [y unit] (NaN: not told apart)
+  };
+  DeadbandCheck deadband;
 };
+
+/// The deadband check's bounds (OutputErrorReport::DeadbandCheck): the share of the input-deadzone
+/// fit's sum of squares a deadband must remove to flag it [-] (the valve rig's unmodelled
+/// dynamics leave at most 3 % to a deadband, issue 30's backlash plant 98 %; docs/identification.md) ...
+inline constexpr double kDeadbandGain = 0.1;
+/// ... and d's start, the share of the fit window's peak |y| [-].
+inline constexpr double kDeadbandStart = 0.01;
 
 /// The names of θ's parameters of one side, by index 0–3: "a1", "b1", "c", "d".
 const char* side_param_name(int i) noexcept;
