@@ -29,7 +29,7 @@ def start_slave(tag):
 
 
 s1 = start_slave("a")
-master = subprocess.Popen([LASH, "hil", "master", "--bus", BUS, "--fifo", "50", "--duration", "4",
+master = subprocess.Popen([LASH, "hil", "master", "--bus", BUS, "--fifo", "50", "--duration", "5",
                            "--reference", "step:from=500,to=1500,time=0.5", "--log", f"{out}/master.csv",
                            "--events", f"{out}/events.csv", "--stats", f"{out}/master.json"],
                           stderr=subprocess.PIPE, text=True)
@@ -53,10 +53,11 @@ print(events)
 assert kinds[:2] == ["ccp_connect_sent", "ccp_connected"], kinds
 assert "sensor_timeout_safe_state" in kinds and "input_resumed" in kinds, kinds
 # The kill is the longest fault (a busy machine may add short ones: each is logged too).
-faults = [(int(e[0]), next(int(r[0]) for r in events[i:] if r[2] == "input_resumed"))
+steps = [int(v) for v in m["step"]]
+# A fault never resumed lasts to the end of the run.
+faults = [(int(e[0]), next((int(r[0]) for r in events[i:] if r[2] == "input_resumed"), steps[-1] + 1))
           for i, e in enumerate(events) if e[2] == "sensor_timeout_safe_state"]
 fault_step, resume_step = max(faults, key=lambda f: f[1] - f[0])
-steps = [int(v) for v in m["step"]]
 row = {s: i for i, s in enumerate(steps)}
 # The property (issue 17): the master enters the safe state within 3 periods of the last fresh
 # sensor frame, logs the fault at that very step, and commands 0 mA from that step until the
@@ -76,7 +77,17 @@ for s in range(safe_from, resume_step):
     assert m["current_mA"][row[s]] == 0.0 and m["state"][row[s]] == SAFE, s
 assert m["state"][row[resume_step]] == RUNNING
 assert (resume_step - fault_step) * 0.005 >= 0.6  # the slave was down for 0.7 s
-tail = [m["measured_kPa"][i] for i, s in enumerate(steps) if s >= resume_step + 200]
+# Tracking is scored on the steps that lie 200 steps (1 s) or more after the latest resume and
+# before any later fault: a short fault a host stall adds (logged, above) drops the valve to 0 mA
+# too, and its own recovery is left out the same way the kill's is, not averaged in.
+
+
+def settled(s):
+    return s >= resume_step + 200 and not any(f <= s < r + 200 for f, r in faults)
+
+
+tail = [m["measured_kPa"][i] for i, s in enumerate(steps) if settled(s)]
+print(f"{len(faults)} fault(s) {faults}; tail of {len(tail)} settled steps")
 assert len(tail) > 50 and abs(sum(tail) / len(tail) - 1500) < 15, sum(tail) / len(tail)
 
 # SIGINT to both nodes: they stop at a step boundary, write whole logs and exit 0.
