@@ -111,6 +111,29 @@ def test_output_error_restarts_leave_a_local_minimum():
                     assert abs(j[k] / want - 1.0) < 1e-6, (i, side, k, j[k], want)
 
 
+def test_joint_check_takes_the_side_fitted_with_a_rejected_one():
+    # Case 386 of seed 3 with E2 noise: a sine 2.4 x the right edge (311); the right guess lies
+    # inside the deadzone, the output-error fit from that estimate ends with c_r = 224, K_r 22 %
+    # low and d_r = 0 (uncertain: its interval reaches d < 0). The left side, fitted together
+    # with it, came out with d_l = 28.2 against the plant's 48.2 (41 % off) and a 95 % interval
+    # of +-9.7 % -- identified before the joint check; now poor_fit, the check in the JSON.
+    p, kind, amp, v, y, rng = vp.draw(386, 3, True)
+    r = lash.estimate(np.arange(len(v)) * vp.DT, v, y, model="deadzone-deadband").to_dict()
+    assert kind == "sine" and r["output_error"]["used"]
+    assert not r["right"]["identified"] and r["right"]["reason"] == "wrong_guess"  # the guess report's
+    assert abs(r["left"]["d"] / p["dl"] - 1.0) > 0.3  # the value the check keeps from being a result
+    lo, hi = r["left"]["ci95"]["d"]
+    assert not lo <= p["dl"] <= hi
+    assert not r["left"]["identified"] and r["left"]["reason"] == "poor_fit"
+    assert r["output_error"]["joint_check"] == {"flagged": True, "rejected": "right", "reason": "uncertain",
+                                                "guess_inside": True}
+    # a case the check leaves alone (both sides identified, within 5 %): case 0
+    p, kind, amp, v, y, rng = vp.draw(0, 3, True)
+    r = lash.estimate(np.arange(len(v)) * vp.DT, v, y, model="deadzone-deadband").to_dict()
+    assert r["output_error"]["joint_check"] == {"flagged": False}
+    assert r["right"]["identified"] and r["left"]["identified"]
+
+
 def test_the_thesis_preset_is_checked_by_output_error():
     # noise-free cases (random settings, seed 3) that --preset thesis identified with a side far
     # off, measured before the output-error check (docs/method.md A4.4c): case 566 right c 4.59

@@ -336,6 +336,14 @@ std::string estimate_auto_json(const AutoRun& ar, Preset preset, const ReportFit
       }
       o["deadband_check"] = c;
     }
+    if (oe.used) {  // a side rejected by checks 3-5 takes the other, fitted with it, along
+      Json c{{"flagged", oe.joint.flagged}};
+      if (oe.joint.flagged)
+        c.update({{"rejected", to_string(oe.joint.rejected)},
+                  {"reason", to_string(oe.joint.reason)},
+                  {"guess_inside", oe.joint.guess_inside}});
+      o["joint_check"] = c;
+    }
     j["output_error"] = o;
   }
   j["preset"] = to_string(preset);
@@ -385,6 +393,17 @@ std::string estimate_auto_text(const AutoRun& ar, double dt_s, const ReportFit& 
                          "{:.6g}: the record shows a backlash this model lacks, both sides reported poor_fit; use "
                          "--model deadzone-deadband\n",
                          db.d[Side::right], db.d[Side::left], oe.fit.rms, db.rms);
+    if (const auto& jc = oe.joint; jc.flagged) {
+      const char *r = to_string(jc.rejected), *o = to_string(jc.rejected == Side::right ? Side::left : Side::right);
+      out += jc.guess_inside
+                 ? fmt::format("joint check: the {} side is not identified ({}) and its guess lies inside the deadzone "
+                               "(the fit started from its samples there); the {} side, fitted together with it, "
+                               "reported poor_fit (give --guess-{} beyond the edge, or drive further beyond it)\n",
+                               r, to_string(jc.reason), o, r)
+                 : fmt::format("joint check: the fit's {} side is {}; the {} side, fitted together with it, reported "
+                               "poor_fit ({})\n",
+                               r, to_string(jc.reason), o, advice);
+    }
   }
   return out;
 }

@@ -328,6 +328,13 @@ SideIntervals fit_intervals(const OutputErrorFit& f, Side side, double dt_s) {
   return ci;
 }
 
+/// Side `s` of `rep` is not identified: reason poor_fit (the free-run fit's checks).
+void mark_poor_fit(EstimateReport& rep, Side s) noexcept {
+  rep[s].params.identified = false;
+  rep[s].params.reason = Reason::poor_fit;
+  rep.identified = false;
+}
+
 /// output_error_check (or a side not_excited): the estimate stays; an identified side the fit
 /// of lowest cost (out.fit, from the estimate and the further starts) moves beyond the bounds in
 /// any of its parameters is reported poor_fit.
@@ -362,11 +369,7 @@ void check_estimate(AutoRun& ar, bool has_d, bool unexcited) {
         m.by = by;
       }
     }
-    if (m.param >= 0) {
-      p.identified = false;
-      p.reason = Reason::poor_fit;
-      rep.identified = false;
-    }
+    if (m.param >= 0) mark_poor_fit(rep, s);
   }
 }
 /// The deadband check (OutputErrorReport::DeadbandCheck) of a used input-deadzone refinement:
@@ -395,11 +398,26 @@ void check_deadband(AutoRun& ar, const RecordColumns& rec, OutputErrorOptions o)
   db.flagged = true;
   EstimateReport& rep = ar.run.report;
   for (const Side s : {Side::right, Side::left})
-    if (rep[s].params.identified) {
-      rep[s].params.identified = false;
-      rep[s].params.reason = Reason::poor_fit;
-    }
+    if (rep[s].params.identified) mark_poor_fit(rep, s);
   rep.identified = false;
+}
+
+/// The joint check (OutputErrorReport::JointCheck) on the refined sides' verdicts and guesses.
+void check_joint(AutoRun& ar) noexcept {
+  OutputErrorReport& out = ar.output_error;
+  EstimateReport& rep = ar.run.report;
+  for (const Side s : {Side::right, Side::left}) {
+    // a guess inside the deadzone (GuessReport::wrong_side): the switching estimate the fit
+    // starts from selected that side's samples from inside the deadzone
+    const bool guess_inside = (s == Side::right ? ar.right : ar.left).wrong_side && !rep[s].params.identified;
+    const Reason why = rep[s].params.reason;
+    const Side other = s == Side::right ? Side::left : Side::right;
+    if (!(guess_inside || why == Reason::unstable || why == Reason::unphysical || why == Reason::wrong_guess) ||
+        !rep[other].params.identified)
+      continue;
+    out.joint = {true, s, why, guess_inside};
+    mark_poor_fit(rep, other);
+  }
 }
 }  // namespace
 
@@ -558,6 +576,7 @@ void refine_by_output_error(AutoRun& ar, const RecordColumns& rec, std::size_t b
     attach_intervals(rep, {fit_intervals(f, Side::right, cfg.dt_s), fit_intervals(f, Side::left, cfg.dt_s)},
                      cfg.ci_tolerance);
   if (cfg.model == ModelKind::input_deadzone) check_deadband(ar, rec, o);
+  check_joint(ar);  // after check 7: a side may be rejected by its intervals
   if (!ar.run.ysim.empty()) {  // the stored free run: the refined model's
     FreeRunDzDb m(f.theta, o.side_by_sign, o.output_deadzone);  // the rule the fit used
     Drive drive(o.dead_time, gap_rows);

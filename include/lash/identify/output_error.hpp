@@ -142,6 +142,19 @@ struct OutputErrorReport {
     PerSide<double> d_half95{};  ///< their 95 % half-widths [y unit] (NaN: not told apart)
   };
   DeadbandCheck deadband;
+  /// The joint check of a used refinement: both sides are fitted together (one free run), so a
+  /// side's values rest on the other side's. When the verdict rejects one side's fitted values
+  /// (unstable, unphysical or wrong_guess: checks 3–5), the other side's, fitted with a model the
+  /// verdict rejects, are reported poor_fit too. Likewise when a side is not identified and its
+  /// switching guess lies inside the deadzone (GuessReport::wrong_side): the estimate the fit
+  /// started from took that side's samples from inside the deadzone.
+  struct JointCheck {
+    bool flagged = false;          ///< the other side was reported poor_fit for it
+    Side rejected = Side::right;   ///< the side that failed
+    Reason reason = Reason::none;  ///< its reason
+    bool guess_inside = false;     ///< flagged for its guess inside the deadzone
+  };
+  JointCheck joint;
 };
 
 /// The deadband check's bounds (OutputErrorReport::DeadbandCheck): the share of the input-deadzone
