@@ -336,7 +336,7 @@ std::string estimate_auto_json(const AutoRun& ar, Preset preset, const ReportFit
       }
       o["deadband_check"] = c;
     }
-    if (oe.used) {  // a side rejected by checks 3-5 takes the other, fitted with it, along
+    if (oe.used) {  // a side rejected (checks 3-5, or its guess inside the deadzone) takes the other along
       Json c{{"flagged", oe.joint.flagged}};
       if (oe.joint.flagged)
         c.update({{"rejected", to_string(oe.joint.rejected)},
