@@ -394,7 +394,7 @@ std::string estimate_auto_text(const AutoRun& ar, double dt_s, const ReportFit& 
                          "--model deadzone-deadband\n",
                          db.d[Side::right], db.d[Side::left], oe.fit.rms, db.rms);
     if (const auto& jc = oe.joint; jc.flagged) {
-      const char *r = to_string(jc.rejected), *o = to_string(jc.rejected == Side::right ? Side::left : Side::right);
+      const char *r = to_string(jc.rejected), *o = to_string(opposite(jc.rejected));
       out += jc.guess_inside
                  ? fmt::format("joint check: the {} side is not identified ({}) and its guess lies inside the deadzone "
                                "(the fit started from its samples there); the {} side, fitted together with it, "

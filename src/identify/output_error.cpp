@@ -399,7 +399,6 @@ void check_deadband(AutoRun& ar, const RecordColumns& rec, OutputErrorOptions o)
   EstimateReport& rep = ar.run.report;
   for (const Side s : {Side::right, Side::left})
     if (rep[s].params.identified) mark_poor_fit(rep, s);
-  rep.identified = false;
 }
 
 /// The joint check (OutputErrorReport::JointCheck) on the refined sides' verdicts and guesses.
@@ -409,9 +408,9 @@ void check_joint(AutoRun& ar) noexcept {
   for (const Side s : {Side::right, Side::left}) {
     // a guess inside the deadzone (GuessReport::wrong_side): the switching estimate the fit
     // starts from selected that side's samples from inside the deadzone
-    const bool guess_inside = (s == Side::right ? ar.right : ar.left).wrong_side && !rep[s].params.identified;
+    const bool guess_inside = ar.guess(s).wrong_side && !rep[s].params.identified;
     const Reason why = rep[s].params.reason;
-    const Side other = s == Side::right ? Side::left : Side::right;
+    const Side other = opposite(s);
     if (!(guess_inside || why == Reason::unstable || why == Reason::unphysical || why == Reason::wrong_guess) ||
         !rep[other].params.identified)
       continue;
@@ -458,7 +457,7 @@ void refine_by_output_error(AutoRun& ar, const RecordColumns& rec, std::size_t b
   OutputErrorParams start{};
   for (const Side s : {Side::right, Side::left}) {
     const SideParams& p = rep[s].params;
-    const SideParams& q = rep[s == Side::right ? Side::left : Side::right].params;
+    const SideParams& q = rep[opposite(s)].params;
     unexcited = unexcited || p.reason == Reason::not_excited;
     if (finite(p)) put(start, s, p);
     else if (finite(q)) {

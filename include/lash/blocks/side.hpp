@@ -12,6 +12,9 @@ enum class Side : std::uint8_t { right = 0, left = 1 };
 /// @see Eq. (34): v ≥ 0 selects the right side.
 constexpr Side side_of(double v) noexcept { return v >= 0.0 ? Side::right : Side::left; }
 
+/// The other side.
+constexpr Side opposite(Side s) noexcept { return s == Side::right ? Side::left : Side::right; }
+
 constexpr const char* to_string(Side s) noexcept { return s == Side::right ? "right" : "left"; }
 
 /// A value for each side.

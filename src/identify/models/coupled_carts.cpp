@@ -65,7 +65,7 @@ void CoupledCartsModel::free_run(EstimatorCore& c) noexcept {
   // (its linear state follows the other side's model if that one is usable).
   const Side ss = detail::free_run_side(x_, sc_, sim_last_);
   sim_last_ = ss;
-  const Side other = ss == Side::right ? Side::left : Side::right;
+  const Side other = opposite(ss);
   const Side ms = valid_[ss] ? ss : other;
   x_ = valid_[ms] ? -sa1_[ms] * x_ + sb1_[ms] * c.vraw1 : 0.0;
   wdot_ = valid_[ss] ? detail::deadzone(x_, sc_.left, sc_.right) : 0.0;
